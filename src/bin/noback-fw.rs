@@ -1,0 +1,30 @@
+//! The actuator firmware image (`cargo xtask run` builds it for thumbv7m and boots it in QEMU).
+//!
+//! Until the firmware issue fills it in, it runs the fixed-point self-check that the host also
+//! runs and prints its digest; the xtask compares that digest with its own native run.
+#![cfg_attr(target_os = "none", no_std, no_main)]
+
+#[cfg(target_os = "none")]
+mod target {
+    use cortex_m_rt::entry;
+    use noback::platform;
+
+    #[entry]
+    fn main() -> ! {
+        defmt::info!("noback firmware {=str}", env!("CARGO_PKG_VERSION"));
+        let report = noback::vectors::run();
+        defmt::info!(
+            "fx-selfcheck cases={=u32} mismatches={=u32} digest={=u32:#010x}",
+            report.cases,
+            report.mismatches,
+            report.digest
+        );
+        platform::exit(if report.mismatches == 0 { 0 } else { 1 })
+    }
+}
+
+/// On the host this binary only says where it runs.
+#[cfg(not(target_os = "none"))]
+fn main() {
+    println!("noback-fw runs on a Cortex-M: use `cargo xtask run` to boot it under QEMU");
+}

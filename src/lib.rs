@@ -1,0 +1,24 @@
+//! noback — a monitor for the ball-ramp no-back brake of a hatch-door actuator.
+//!
+//! The brake (Wang, Dou, Dong, *Aerospace* 2023, 10, 227) holds the door when load torque on the
+//! output shaft makes steel balls climb conical sockets and clamp a multi-disc friction pack.
+//! This crate is the part that flies: `no_std`, allocation-free and panic-free, so that the same
+//! code runs under host `cargo test` and on a Cortex-M with bit-identical fixed-point results.
+//!
+//! - [`mechanism`]: the paper's Table 2 and the closed-form relations (ramp factor, pack
+//!   capacity), written once and used by the twin in f64 and by the monitor in fixed point.
+//! - [`sensors`]: motor, reducer, ADC and encoder defaults shared by twin and monitor.
+//! - [`monitor`]: the 10 kHz reduced model, observer and failure flags.
+//! - [`fx`]: fixed-point formats and the small saturating/wrapping helpers the monitor uses.
+//! - [`vectors`]: test vectors run natively and under QEMU; the xtask compares the two digests.
+//! - `platform` (target only): panic and HardFault exits, defmt transport.
+#![no_std]
+
+pub mod fx;
+pub mod mechanism;
+pub mod monitor;
+pub mod sensors;
+pub mod vectors;
+
+#[cfg(target_os = "none")]
+pub mod platform;
