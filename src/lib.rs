@@ -11,9 +11,11 @@
 //! - [`monitor`]: the 10 kHz reduced model, observer and failure flags.
 //! - [`fx`]: fixed-point formats and the small saturating/wrapping helpers the monitor uses.
 //! - [`vectors`]: test vectors run natively and under QEMU; the xtask compares the two digests.
+//! - [`exit_code`]: how a run under QEMU ends, shared with the xtask.
 //! - `platform` (target only): panic and HardFault exits, defmt transport.
 #![no_std]
 
+pub mod exit_code;
 pub mod fx;
 pub mod mechanism;
 pub mod monitor;

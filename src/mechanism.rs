@@ -246,7 +246,10 @@ mod tests {
         for i in -150..150 {
             let x = f64::from(i) * 0.01;
             let exact = x.sin() / x.cos(); // host std here is only the reference
-            assert!((tan(x) - exact).abs() <= 1e-12 * exact.abs().max(1.0), "{x}");
+            assert!(
+                (tan(x) - exact).abs() <= 1e-12 * exact.abs().max(1.0),
+                "{x}"
+            );
         }
     }
 

@@ -5,14 +5,10 @@
 //! real ECU a BSP would replace the exit with a safe-state reset. defmt frames go out over
 //! semihosting (`defmt-semihosting`), which QEMU writes to stdout for the xtask to decode.
 
-use cortex_m_rt::{exception, ExceptionFrame};
+use crate::exit_code;
 use cortex_m as _; // links its single-core critical-section implementation
+use cortex_m_rt::{exception, ExceptionFrame};
 use defmt_semihosting as _;
-
-/// Exit code a panic ends the emulated run with.
-pub const EXIT_PANIC: i32 = 101;
-/// Exit code a HardFault ends the emulated run with.
-pub const EXIT_HARDFAULT: i32 = 102;
 
 /// Ends the emulated run with `code` (semihosting `SYS_EXIT_EXTENDED`, then `SYS_EXIT`).
 pub fn exit(code: i32) -> ! {
@@ -21,18 +17,18 @@ pub fn exit(code: i32) -> ! {
 
 #[defmt::panic_handler]
 fn defmt_panic() -> ! {
-    exit(EXIT_PANIC)
+    exit(exit_code::PANIC)
 }
 
 #[panic_handler]
 fn panic(info: &core::panic::PanicInfo<'_>) -> ! {
     defmt::error!("panic: {}", defmt::Display2Format(info));
-    exit(EXIT_PANIC)
+    exit(exit_code::PANIC)
 }
 
 #[exception]
 #[allow(unsafe_code)] // cortex-m-rt requires HardFault handlers to be `unsafe fn`.
 unsafe fn HardFault(frame: &ExceptionFrame) -> ! {
     defmt::error!("HardFault at pc={=u32:#010x}", frame.pc());
-    exit(EXIT_HARDFAULT)
+    exit(exit_code::HARDFAULT)
 }

@@ -19,7 +19,11 @@ mod target {
             report.mismatches,
             report.digest
         );
-        platform::exit(if report.mismatches == 0 { 0 } else { 1 })
+        platform::exit(if report.mismatches == 0 {
+            noback::exit_code::SUCCESS
+        } else {
+            noback::exit_code::SELFCHECK_FAILED
+        })
     }
 }
 

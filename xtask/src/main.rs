@@ -1,1 +1,69 @@
-fn main(){}
+//! `cargo xtask` — noback's commands. Automation only: no physics lives here.
+//!
+//! Each command is one file; this one parses the command line and dispatches. The README's two
+//! commands are `cargo xtask run` (the main job) and `cargo xtask test` (every test).
+
+mod bootstrap;
+mod cores;
+mod defmt_log;
+mod qemu;
+mod run;
+mod shell;
+mod test;
+#[cfg(test)]
+mod tidy;
+
+use std::process::ExitCode;
+
+/// Every command, with its one-line help. The tidy test checks the README names only these.
+pub const COMMANDS: &[(&str, &str)] = &[
+    (
+        "run",
+        "build the firmware (release, thumbv7m) and boot it in QEMU, printing its decoded log",
+    ),
+    (
+        "test",
+        "every test: fmt, clippy, tidy, host tests, target tests under QEMU on M0/M3/M4F",
+    ),
+    (
+        "qemu",
+        "ELF [--core m0|m3|m4f] [--timeout S]: boot an ELF in QEMU, decode defmt (the cargo runner)",
+    ),
+    (
+        "bootstrap",
+        "add missing rustup targets and install qemu-system-arm if missing",
+    ),
+];
+
+fn usage() -> ExitCode {
+    eprintln!("usage: cargo xtask <command> [args]\n\ncommands:");
+    for (name, help) in COMMANDS {
+        eprintln!("  {name:<10} {help}");
+    }
+    ExitCode::from(2)
+}
+
+fn main() -> ExitCode {
+    let args: Vec<String> = std::env::args().skip(1).collect();
+    let Some((command, rest)) = args.split_first() else {
+        return usage();
+    };
+    let result = match command.as_str() {
+        "run" => run::main(rest),
+        "test" => test::main(rest),
+        "qemu" => qemu::main(rest),
+        "bootstrap" => bootstrap::ensure_all().map(|()| 0),
+        "-h" | "--help" | "help" => return usage(),
+        other => {
+            eprintln!("xtask: unknown command `{other}`");
+            return usage();
+        }
+    };
+    match result {
+        Ok(code) => ExitCode::from(u8::try_from(code).unwrap_or(1)),
+        Err(e) => {
+            eprintln!("xtask {command}: error: {e}");
+            ExitCode::from(1)
+        }
+    }
+}

@@ -1,0 +1,78 @@
+//! The three emulated Cortex-M cores we test on, and how QEMU boots each.
+//!
+//! One memory map (`memory.x`: 256 K flash at 0x0, 64 K RAM at 0x2000_0000) fits both boards.
+//! Hard-float code faults on lm3s6965evb at its first VFP instruction, so the M4F runs on
+//! mps2-an386, which has the FPU.
+
+/// A core under test.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Core {
+    /// Cortex-M0 (ARMv6-M): lm3s6965evb with `-cpu cortex-m0`.
+    M0,
+    /// Cortex-M3 (ARMv7-M): lm3s6965evb.
+    M3,
+    /// Cortex-M4 with FPU (ARMv7E-M, hard float): mps2-an386.
+    M4f,
+}
+
+impl Core {
+    /// Every core, in test order.
+    pub const ALL: [Core; 3] = [Core::M0, Core::M3, Core::M4f];
+
+    /// Name on the command line.
+    pub fn name(self) -> &'static str {
+        match self {
+            Core::M0 => "m0",
+            Core::M3 => "m3",
+            Core::M4f => "m4f",
+        }
+    }
+
+    /// Rust target triple.
+    pub fn triple(self) -> &'static str {
+        match self {
+            Core::M0 => "thumbv6m-none-eabi",
+            Core::M3 => "thumbv7m-none-eabi",
+            Core::M4f => "thumbv7em-none-eabihf",
+        }
+    }
+
+    /// QEMU `-machine` and `-cpu`.
+    pub fn machine_cpu(self) -> (&'static str, &'static str) {
+        match self {
+            Core::M0 => ("lm3s6965evb", "cortex-m0"),
+            Core::M3 => ("lm3s6965evb", "cortex-m3"),
+            Core::M4f => ("mps2-an386", "cortex-m4"),
+        }
+    }
+
+    /// Parses a command-line name (`m0`, `m3`, `m4f`).
+    pub fn parse(name: &str) -> Result<Core, String> {
+        Core::ALL
+            .into_iter()
+            .find(|c| c.name() == name)
+            .ok_or_else(|| format!("unknown core `{name}` (expected m0, m3 or m4f)"))
+    }
+
+    /// The core whose target triple appears in a build path, e.g.
+    /// `target/thumbv6m-none-eabi/debug/deps/on_target-…`.
+    pub fn from_path(path: &str) -> Option<Core> {
+        Core::ALL.into_iter().find(|c| path.contains(c.triple()))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn cores_round_trip_and_are_found_in_paths() {
+        for core in Core::ALL {
+            assert_eq!(Core::parse(core.name()), Ok(core));
+            let path = format!("/w/target/{}/release/noback-fw", core.triple());
+            assert_eq!(Core::from_path(&path), Some(core));
+        }
+        assert!(Core::parse("m7").is_err());
+        assert_eq!(Core::from_path("target/debug/xtask"), None);
+    }
+}

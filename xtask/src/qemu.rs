@@ -1,0 +1,163 @@
+//! `cargo xtask qemu ELF` — boots a firmware or target-test ELF under QEMU (the cargo runner).
+//!
+//! It picks the board from the target triple in the ELF's path (or `--core`), decodes defmt
+//! from semihosting stdout, passes QEMU's exit code through (semihosting exit), and ends a hung
+//! QEMU after `--timeout` seconds with exit code 124 and a message: QEMU killed by a signal
+//! would otherwise exit 0.
+
+use crate::cores::Core;
+use crate::defmt_log::LogDecoder;
+use std::io::Read;
+use std::process::{Command, Stdio};
+use std::sync::mpsc;
+use std::time::{Duration, Instant};
+
+/// Exit code for a run that QEMU did not finish in time.
+pub const EXIT_TIMEOUT: i32 = 124;
+
+/// How to boot one image.
+pub struct Boot<'a> {
+    /// Path of the ELF.
+    pub elf: &'a str,
+    /// Core to emulate.
+    pub core: Core,
+    /// Wall-clock limit.
+    pub timeout: Duration,
+    /// Extra QEMU flags (e.g. `-icount`).
+    pub extra: Vec<String>,
+    /// Print decoded lines as they arrive.
+    pub echo: bool,
+}
+
+/// What a boot produced.
+pub struct Outcome {
+    /// QEMU's exit code (the firmware's semihosting exit code), or [`EXIT_TIMEOUT`].
+    pub code: i32,
+    /// Decoded defmt lines.
+    pub lines: Vec<String>,
+}
+
+/// The QEMU command line for `core` booting `elf`.
+pub fn command(core: Core, elf: &str, extra: &[String]) -> Command {
+    let (machine, cpu) = core.machine_cpu();
+    let mut cmd = Command::new("qemu-system-arm");
+    cmd.args(["-machine", machine, "-cpu", cpu])
+        .args(["-nographic", "-monitor", "none", "-serial", "none"])
+        .args(["-semihosting-config", "enable=on,target=native"])
+        .args(extra)
+        .args(["-kernel", elf]);
+    cmd
+}
+
+/// Boots an image and decodes its log.
+pub fn boot(boot: &Boot<'_>) -> Result<Outcome, String> {
+    let elf_bytes = std::fs::read(boot.elf).map_err(|e| format!("reading {}: {e}", boot.elf))?;
+    let mut decoder = LogDecoder::from_elf(&elf_bytes)?;
+    let mut child = command(boot.core, boot.elf, &boot.extra)
+        .stdin(Stdio::null())
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .map_err(|e| format!("starting qemu-system-arm: {e} (run `cargo xtask bootstrap`)"))?;
+    let mut stdout = child.stdout.take().ok_or("qemu stdout was not captured")?;
+    if let Some(stderr) = child.stderr.take() {
+        std::thread::spawn(move || forward_stderr(stderr));
+    }
+    let (tx, rx) = mpsc::channel::<Vec<u8>>();
+    let reader = std::thread::spawn(move || {
+        let mut buf = [0_u8; 4096];
+        while let Ok(n) = stdout.read(&mut buf) {
+            if n == 0 || tx.send(buf.get(..n).unwrap_or_default().to_vec()).is_err() {
+                break;
+            }
+        }
+    });
+    let started = Instant::now();
+    let mut lines = Vec::new();
+    let mut take = |chunk: Vec<u8>, lines: &mut Vec<String>| {
+        for line in decoder.feed(&chunk) {
+            if boot.echo {
+                println!("{line}");
+            }
+            lines.push(line);
+        }
+    };
+    let code = loop {
+        while let Ok(chunk) = rx.try_recv() {
+            take(chunk, &mut lines);
+        }
+        if let Some(status) = child.try_wait().map_err(|e| e.to_string())? {
+            break status.code().unwrap_or(EXIT_TIMEOUT);
+        }
+        if started.elapsed() > boot.timeout {
+            let _ = child.kill();
+            let _ = child.wait();
+            eprintln!(
+                "xtask qemu: {} did not finish within {:.0} s on {}; killed (exit {EXIT_TIMEOUT})",
+                boot.elf,
+                boot.timeout.as_secs_f64(),
+                boot.core.name()
+            );
+            break EXIT_TIMEOUT;
+        }
+        if let Ok(chunk) = rx.recv_timeout(Duration::from_millis(20)) {
+            take(chunk, &mut lines);
+        }
+    };
+    let _ = reader.join();
+    while let Ok(chunk) = rx.try_recv() {
+        take(chunk, &mut lines);
+    }
+    if decoder.malformed > 0 {
+        eprintln!("xtask qemu: {} malformed defmt frame(s)", decoder.malformed);
+    }
+    Ok(Outcome { code, lines })
+}
+
+/// QEMU's own messages, less the lm3s6965evb's harmless "Timer with period zero" notice.
+fn forward_stderr(stderr: std::process::ChildStderr) {
+    use std::io::BufRead;
+    for line in std::io::BufReader::new(stderr)
+        .lines()
+        .map_while(Result::ok)
+    {
+        if line != "Timer with period zero, disabling" {
+            eprintln!("qemu: {line}");
+        }
+    }
+}
+
+/// The runner entry: `qemu ELF [--core C] [--timeout S] [test-args…]`.
+pub fn main(args: &[String]) -> Result<i32, String> {
+    let mut elf = None;
+    let mut core = None;
+    let mut timeout = 60.0_f64;
+    let mut it = args.iter();
+    while let Some(arg) = it.next() {
+        match arg.as_str() {
+            "--core" => core = Some(Core::parse(it.next().ok_or("--core needs a value")?)?),
+            "--timeout" => {
+                timeout = it
+                    .next()
+                    .and_then(|v| v.parse().ok())
+                    .filter(|t: &f64| *t > 0.0)
+                    .ok_or("--timeout needs a positive number of seconds")?;
+            }
+            // cargo passes test-harness arguments after the ELF; defmt-test takes none.
+            other if elf.is_none() && !other.starts_with('-') => elf = Some(other.to_string()),
+            _ => {}
+        }
+    }
+    let elf = elf.ok_or("usage: cargo xtask qemu ELF [--core m0|m3|m4f] [--timeout S]")?;
+    let core = core
+        .or_else(|| Core::from_path(&elf))
+        .ok_or_else(|| format!("cannot tell the core from `{elf}`: pass --core m0|m3|m4f"))?;
+    let outcome = boot(&Boot {
+        elf: &elf,
+        core,
+        timeout: Duration::from_secs_f64(timeout),
+        extra: Vec::new(),
+        echo: true,
+    })?;
+    Ok(outcome.code)
+}

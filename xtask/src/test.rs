@@ -1,0 +1,215 @@
+//! `cargo xtask test` — every test, in the order that fails fastest:
+//! format, clippy (host and each thumb target), host tests (library, host-tests, twin, tidy),
+//! then under QEMU on M0, M3 and M4F: the defmt-test target tests and the release firmware.
+//! The digest each target prints is compared here with the one computed natively: that is the
+//! bit-identity check, made by the xtask rather than asserted by the target about itself.
+
+use crate::bootstrap;
+use crate::cores::Core;
+use crate::qemu;
+use crate::shell::{self, cargo};
+use std::io::{BufRead, BufReader};
+use std::process::Stdio;
+use std::time::{Duration, Instant};
+
+/// Entry: `test [--core m0|m3|m4f]…` (default: all three cores).
+pub fn main(args: &[String]) -> Result<i32, String> {
+    let mut cores = Vec::new();
+    let mut it = args.iter();
+    while let Some(arg) = it.next() {
+        match arg.as_str() {
+            "--core" => cores.push(Core::parse(it.next().ok_or("--core needs a value")?)?),
+            other => return Err(format!("unknown argument `{other}` (try --core m0|m3|m4f)")),
+        }
+    }
+    if cores.is_empty() {
+        cores = Core::ALL.to_vec();
+    }
+    let started = Instant::now();
+    bootstrap::ensure_all()?;
+
+    section("format");
+    shell::run(cargo().args(["fmt", "--all", "--", "--check"]))?;
+    section("clippy (host)");
+    shell::run(cargo().args([
+        "clippy",
+        "--workspace",
+        "--all-targets",
+        "--",
+        "-D",
+        "warnings",
+    ]))?;
+    for &core in &cores {
+        section(&format!("clippy ({})", core.triple()));
+        shell::run(cargo().args([
+            "clippy",
+            "-p",
+            "noback",
+            "--target",
+            core.triple(),
+            "--lib",
+            "--bins",
+            "--test",
+            "on_target",
+            "--",
+            "-D",
+            "warnings",
+        ]))?;
+    }
+    section("host tests (library, host-tests, twin, xtask tidy)");
+    shell::run(cargo().args(["test", "--workspace"]))?;
+
+    let host_digest = noback::vectors::run().digest;
+    let mut rows = Vec::new();
+    for &core in &cores {
+        section(&format!("target tests under QEMU ({})", core.name()));
+        let lines = target_tests(core)?;
+        let test_digest = digest_in(&lines)?;
+        section(&format!("fault probes under QEMU ({})", core.name()));
+        fault_probes(core)?;
+        section(&format!("firmware under QEMU ({}, release)", core.name()));
+        let fw = crate::run::build_and_boot(core, true)?;
+        if fw.code != 0 {
+            return Err(format!(
+                "firmware on {} exited with {}",
+                core.name(),
+                fw.code
+            ));
+        }
+        let fw_digest = digest_in(&fw.lines)?;
+        rows.push((core, test_digest, fw_digest));
+    }
+
+    section("bit-identity of the fixed-point vectors");
+    println!("host digest {host_digest:#010x}");
+    let mut identical = true;
+    for (core, test_digest, fw_digest) in &rows {
+        let ok = *test_digest == host_digest && *fw_digest == host_digest;
+        identical &= ok;
+        println!(
+            "{:<4} test {test_digest:#010x}  firmware {fw_digest:#010x}  {}",
+            core.name(),
+            if ok { "identical" } else { "DIFFERENT" }
+        );
+    }
+    if !identical {
+        return Err("a target computed different bits from the host".into());
+    }
+    println!(
+        "\nxtask test: all passed in {:.0} s",
+        started.elapsed().as_secs_f64()
+    );
+    Ok(0)
+}
+
+fn section(title: &str) {
+    println!("\n=== {title} ===");
+}
+
+/// Runs the defmt-test target tests for `core` under QEMU (this xtask as the cargo runner),
+/// echoing and returning their output lines.
+fn target_tests(core: Core) -> Result<Vec<String>, String> {
+    let exe = std::env::current_exe().map_err(|e| e.to_string())?;
+    let runner_var = format!(
+        "CARGO_TARGET_{}_RUNNER",
+        core.triple().to_uppercase().replace('-', "_")
+    );
+    let mut cmd = cargo();
+    cmd.args([
+        "test",
+        "-p",
+        "noback",
+        "--target",
+        core.triple(),
+        "--test",
+        "on_target",
+    ])
+    .env(runner_var, format!("{} qemu --timeout 60", exe.display()))
+    .stdout(Stdio::piped());
+    println!("$ {}", shell::describe(&cmd));
+    let mut child = cmd.spawn().map_err(|e| format!("starting cargo: {e}"))?;
+    let mut lines = Vec::new();
+    if let Some(out) = child.stdout.take() {
+        for line in BufReader::new(out).lines().map_while(Result::ok) {
+            println!("{line}");
+            lines.push(line);
+        }
+    }
+    let status = child.wait().map_err(|e| e.to_string())?;
+    if !status.success() {
+        return Err(format!("target tests failed on {} ({status})", core.name()));
+    }
+    Ok(lines)
+}
+
+/// Boots the three fault probes and checks each ends with its own non-zero exit code.
+fn fault_probes(core: Core) -> Result<(), String> {
+    let expected = [
+        ("probe_panic", noback::exit_code::PANIC),
+        ("probe_hardfault", noback::exit_code::HARDFAULT),
+        ("probe_hang", qemu::EXIT_TIMEOUT),
+    ];
+    let mut cmd = cargo();
+    cmd.args(["build", "-p", "noback", "--target", core.triple()]);
+    for (name, _) in expected {
+        cmd.args(["--test", name]);
+    }
+    let elfs = shell::built_executables(&mut cmd)?;
+    for (name, code) in expected {
+        let elf = elfs
+            .iter()
+            .find(|(target, _)| target == name)
+            .map(|(_, path)| path.clone())
+            .ok_or_else(|| format!("cargo built no executable for {name}"))?;
+        let outcome = qemu::boot(&qemu::Boot {
+            elf: &elf,
+            core,
+            timeout: Duration::from_secs(3),
+            extra: Vec::new(),
+            echo: false,
+        })?;
+        let verdict = if outcome.code == code { "ok" } else { "WRONG" };
+        println!(
+            "{name:<16} exit {:>3} (expected {code}) {verdict}",
+            outcome.code
+        );
+        if outcome.code != code {
+            return Err(format!(
+                "{name} on {} exited {} instead of {code}",
+                core.name(),
+                outcome.code
+            ));
+        }
+    }
+    Ok(())
+}
+
+/// The `digest=0x…` value a self-check line carries.
+pub fn digest_in(lines: &[String]) -> Result<u32, String> {
+    lines
+        .iter()
+        .filter(|l| l.contains("fx-selfcheck"))
+        .find_map(|l| {
+            let hex = l.split("digest=0x").nth(1)?;
+            u32::from_str_radix(hex.get(..8)?, 16).ok()
+        })
+        .ok_or_else(|| "no `fx-selfcheck … digest=0x…` line in the target's log".into())
+}
+
+/// How long one QEMU boot may take before it counts as hung.
+pub const BOOT_TIMEOUT: Duration = Duration::from_secs(60);
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn digest_is_found_in_a_decoded_line() {
+        let lines = vec![
+            "INFO noback".to_string(),
+            "INFO fx-selfcheck cases=10 mismatches=0 digest=0x1a2b3c4d".to_string(),
+        ];
+        assert_eq!(digest_in(&lines), Ok(0x1a2b_3c4d));
+        assert!(digest_in(&lines[..1]).is_err());
+    }
+}
