@@ -5,6 +5,8 @@
 //! real ECU a BSP would replace the exit with a safe-state reset. defmt frames go out over
 //! semihosting (`defmt-semihosting`), which QEMU writes to stdout for the xtask to decode.
 
+pub mod meter;
+
 use crate::exit_code;
 use cortex_m as _; // links its single-core critical-section implementation
 use cortex_m_rt::{exception, ExceptionFrame};

@@ -7,17 +7,27 @@
 #[cfg(target_os = "none")]
 mod target {
     use cortex_m_rt::entry;
-    use noback::platform;
+    use noback::platform::{self, meter::Meter};
 
     #[entry]
     fn main() -> ! {
         defmt::info!("noback firmware {=str}", env!("CARGO_PKG_VERSION"));
+        let Some(peripherals) = cortex_m::Peripherals::take() else {
+            platform::exit(noback::exit_code::PANIC)
+        };
+        let meter = Meter::start(peripherals.SYST);
+        // Cost of an empty measurement, to subtract on the host side.
+        let (a, b) = (meter.now(), meter.now());
+        let start = meter.now();
         let report = noback::vectors::run();
+        let end = meter.now();
         defmt::info!(
-            "fx-selfcheck cases={=u32} mismatches={=u32} digest={=u32:#010x}",
+            "fx-selfcheck cases={=u32} mismatches={=u32} digest={=u32:#010x} ticks={=u32} overhead={=u32}",
             report.cases,
             report.mismatches,
-            report.digest
+            report.digest,
+            Meter::ticks(start, end),
+            Meter::ticks(a, b)
         );
         platform::exit(if report.mismatches == 0 {
             noback::exit_code::SUCCESS

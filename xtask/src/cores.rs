@@ -46,6 +46,20 @@ impl Core {
         }
     }
 
+    /// Processor clock of the board under QEMU (Hz): what the firmware's `Meter` (SysTick on the
+    /// core clock) counts.
+    pub fn systick_clock_hz(self) -> f64 {
+        match self {
+            Core::M0 | Core::M3 => 12.5e6,
+            Core::M4f => 25.0e6,
+        }
+    }
+
+    /// SysTick ticks per executed instruction under `-icount shift=N` (2^N ns per instruction).
+    pub fn ticks_per_insn(self, shift: u32) -> f64 {
+        f64::from(1_u32 << shift) * 1e-9 * self.systick_clock_hz()
+    }
+
     /// Parses a command-line name (`m0`, `m3`, `m4f`).
     pub fn parse(name: &str) -> Result<Core, String> {
         Core::ALL

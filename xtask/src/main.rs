@@ -6,6 +6,8 @@
 mod bootstrap;
 mod cores;
 mod defmt_log;
+mod elf_size;
+mod opt_level;
 mod qemu;
 mod run;
 mod shell;
@@ -27,7 +29,11 @@ pub const COMMANDS: &[(&str, &str)] = &[
     ),
     (
         "qemu",
-        "ELF [--core m0|m3|m4f] [--timeout S]: boot an ELF in QEMU, decode defmt (the cargo runner)",
+        "ELF [--core m0|m3|m4f] [--timeout S] [--icount SHIFT]: boot an ELF in QEMU, decode defmt (the cargo runner)",
+    ),
+    (
+        "opt-level",
+        "measure flash and instructions at each opt-level; writes docs/results/opt-level.md",
     ),
     (
         "bootstrap",
@@ -52,6 +58,7 @@ fn main() -> ExitCode {
         "run" => run::main(rest),
         "test" => test::main(rest),
         "qemu" => qemu::main(rest),
+        "opt-level" => opt_level::main(rest),
         "bootstrap" => bootstrap::ensure_all().map(|()| 0),
         "-h" | "--help" | "help" => return usage(),
         other => {

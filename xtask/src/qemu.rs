@@ -49,6 +49,15 @@ pub fn command(core: Core, elf: &str, extra: &[String]) -> Command {
     cmd
 }
 
+/// QEMU flags that make virtual time advance exactly 2^`shift` ns per executed instruction, so
+/// SysTick counts instructions deterministically (see `Core::ticks_per_insn`).
+pub fn icount(shift: u32) -> Vec<String> {
+    vec![
+        "-icount".into(),
+        format!("shift={shift},align=off,sleep=off"),
+    ]
+}
+
 /// Boots an image and decodes its log.
 pub fn boot(boot: &Boot<'_>) -> Result<Outcome, String> {
     let elf_bytes = std::fs::read(boot.elf).map_err(|e| format!("reading {}: {e}", boot.elf))?;
@@ -132,10 +141,19 @@ pub fn main(args: &[String]) -> Result<i32, String> {
     let mut elf = None;
     let mut core = None;
     let mut timeout = 60.0_f64;
+    let mut extra = Vec::new();
     let mut it = args.iter();
     while let Some(arg) = it.next() {
         match arg.as_str() {
             "--core" => core = Some(Core::parse(it.next().ok_or("--core needs a value")?)?),
+            "--icount" => {
+                let shift: u32 = it
+                    .next()
+                    .and_then(|v| v.parse().ok())
+                    .filter(|s| *s <= 10)
+                    .ok_or("--icount needs a shift 0..=10")?;
+                extra = icount(shift);
+            }
             "--timeout" => {
                 timeout = it
                     .next()
@@ -148,7 +166,8 @@ pub fn main(args: &[String]) -> Result<i32, String> {
             _ => {}
         }
     }
-    let elf = elf.ok_or("usage: cargo xtask qemu ELF [--core m0|m3|m4f] [--timeout S]")?;
+    let elf =
+        elf.ok_or("usage: cargo xtask qemu ELF [--core m0|m3|m4f] [--timeout S] [--icount SHIFT]")?;
     let core = core
         .or_else(|| Core::from_path(&elf))
         .ok_or_else(|| format!("cannot tell the core from `{elf}`: pass --core m0|m3|m4f"))?;
@@ -156,7 +175,7 @@ pub fn main(args: &[String]) -> Result<i32, String> {
         elf: &elf,
         core,
         timeout: Duration::from_secs_f64(timeout),
-        extra: Vec::new(),
+        extra,
         echo: true,
     })?;
     Ok(outcome.code)
