@@ -11,16 +11,24 @@
 //! - [`monitor`]: the 10 kHz reduced model, observer and failure flags.
 //! - [`fx`]: fixed-point formats and the small saturating/wrapping helpers the monitor uses.
 //! - [`vectors`]: test vectors run natively and under QEMU; the xtask compares the two digests.
+//! - [`board`], [`replay`], [`app`], [`event_log`]: the firmware's portable half — sensor
+//!   traits, the replayed twin trace, the work of one tick, the log ring buffer.
+//! - [`digest`]: the FNV-1a digest host and targets compare.
 //! - [`exit_code`]: how a run under QEMU ends, shared with the xtask.
 //! - `platform` (target only): panic and HardFault exits, defmt transport.
 #![no_std]
 
+pub mod app;
+pub mod board;
+pub mod digest;
+pub mod event_log;
 pub mod exit_code;
 pub mod fx;
 pub mod mechanism;
 pub mod monitor;
+pub mod replay;
 pub mod sensors;
 pub mod vectors;
 
-#[cfg(target_os = "none")]
+#[cfg(all(target_os = "none", feature = "platform"))]
 pub mod platform;

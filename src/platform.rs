@@ -6,6 +6,7 @@
 //! semihosting (`defmt-semihosting`), which QEMU writes to stdout for the xtask to decode.
 
 pub mod meter;
+pub mod stack;
 
 use crate::exit_code;
 use cortex_m as _; // links its single-core critical-section implementation

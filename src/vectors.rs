@@ -7,6 +7,7 @@
 //! compares the digest printed under QEMU with the one it computes natively, so "bit-identical"
 //! is checked by a third party rather than asserted by the target about itself.
 
+use crate::digest::Fnv1a;
 use crate::fx::{adc_centered, counter_delta, lowpass, mul_sat, scale_count, Gain, Q16};
 
 /// Number of generated vectors per helper (the edge cases come on top).
@@ -50,17 +51,6 @@ impl Xorshift32 {
     }
 }
 
-struct Fnv(u32);
-
-impl Fnv {
-    fn push(&mut self, word: u32) {
-        for byte in word.to_le_bytes() {
-            self.0 ^= u32::from(byte);
-            self.0 = self.0.wrapping_mul(0x0100_0193);
-        }
-    }
-}
-
 /// Runs every helper over every vector; see the module doc.
 pub fn run() -> Report {
     let mut report = Report {
@@ -68,7 +58,7 @@ pub fn run() -> Report {
         mismatches: 0,
         digest: 0,
     };
-    let mut fnv = Fnv(0x811C_9DC5);
+    let mut fnv = Fnv1a::new();
     let mut rng = Xorshift32(0x2545_F491);
     let mut pairs = EDGES
         .iter()
@@ -92,7 +82,7 @@ pub fn run() -> Report {
             fnv.push(got);
         }
     }
-    report.digest = fnv.0;
+    report.digest = fnv.value();
     report
 }
 

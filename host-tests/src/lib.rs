@@ -1,4 +1,8 @@
-//! Host-only test support for noback; the tests themselves are in `host-tests/tests/`.
+//! Host-only support for noback's tests and reports: the monitor run over twin traces and
+//! compared with the twin's truth ([`accuracy`]). The tests themselves are in `host-tests/tests/`.
 //!
-//! Kept as a crate of its own so that tests needing std (proptest, f64 references, file I/O)
-//! never touch the `no_std` library's dependency graph.
+//! A crate of its own so that code needing std (f64 references, file I/O, the twin) never
+//! touches the `no_std` library's dependency graph; it is the one place that knows both the
+//! monitor and the twin, which know nothing of each other.
+
+pub mod accuracy;

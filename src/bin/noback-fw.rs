@@ -1,39 +1,253 @@
-//! The actuator firmware image (`cargo xtask run` builds it for thumbv7m and boots it in QEMU).
+//! The actuator firmware image: the monitor at 10 kHz on a Cortex-M, here replaying a twin
+//! trace under QEMU (`cargo xtask run` builds it, embeds the trace and boots it).
 //!
-//! Until the firmware issue fills it in, it runs the fixed-point self-check that the host also
-//! runs and prints its digest; the xtask compares that digest with its own native run.
+//! All target-only code of the product is in this file and `noback::platform`; the work of a
+//! tick is the portable `noback::app::Ticker`, which the host tests run too. Two modes, chosen
+//! by the semihosting argument QEMU passes:
+//! - `realtime` (default): SysTick interrupts at 10 kHz; each interrupt steps the monitor on
+//!   the next sample and drives the alarm pin; the main loop drains the log ring buffer to
+//!   defmt, so logging never blocks the interrupt. `overrun-at=N` burns time in tick N to
+//!   provoke a missed deadline, which must be counted and flagged.
+//! - `bench`: the same monitor steps back to back without interrupts, each `Monitor::step`
+//!   measured alone with SysTick, for deterministic instruction counts under QEMU `-icount`.
+//!
+//! Both end with a `summary` line carrying the digest of every estimate, which the xtask
+//! compares with the host's run on the same trace.
 #![cfg_attr(target_os = "none", no_std, no_main)]
 
 #[cfg(target_os = "none")]
 mod target {
-    use cortex_m_rt::entry;
-    use noback::platform::{self, meter::Meter};
+    use core::cell::RefCell;
+    use core::sync::atomic::{AtomicBool, AtomicU32, AtomicU8, Ordering};
+    use cortex_m::peripheral::{syst::SystClkSource, SCB, SYST};
+    use cortex_m_rt::{entry, exception};
+    use critical_section::Mutex;
+    use noback::app::Ticker;
+    use noback::board::SampleSource;
+    use noback::digest::Fnv1a;
+    use noback::event_log::Event;
+    use noback::monitor::{Config, Monitor};
+    use noback::platform::{self, meter::Meter, stack};
+    use noback::replay::Replay;
+
+    /// The trace `cargo xtask run` embeds (`NOBACK_REPLAY`, copied by build.rs).
+    static TRACE: &[u8] = include_bytes!(concat!(env!("OUT_DIR"), "/replay.bin"));
+
+    /// Board clock under QEMU (Hz): lm3s6965evb 12.5 MHz, mps2-an386 25 MHz.
+    #[cfg(not(target_abi = "eabihf"))]
+    const CLOCK_HZ: u32 = 12_500_000;
+    #[cfg(target_abi = "eabihf")]
+    const CLOCK_HZ: u32 = 25_000_000;
+    /// Tick rate.
+    const TICK_HZ: u32 = 10_000;
+
+    type App = Ticker<Replay<'static>, AlarmPin>;
+    static APP: Mutex<RefCell<Option<App>>> = Mutex::new(RefCell::new(None));
+    /// Ticks elapsed to report on the next interrupt (2 after a missed deadline).
+    static ELAPSED: AtomicU8 = AtomicU8::new(1);
+    static DONE: AtomicBool = AtomicBool::new(false);
+    static OVERRUN_AT: AtomicU32 = AtomicU32::new(u32::MAX);
+    static TICK_NO: AtomicU32 = AtomicU32::new(0);
+
+    /// The alarm output. Under QEMU a plain latch; a board passes its GPIO's `OutputPin`.
+    pub struct AlarmPin {
+        high: bool,
+    }
+    impl embedded_hal::digital::ErrorType for AlarmPin {
+        type Error = core::convert::Infallible;
+    }
+    impl embedded_hal::digital::OutputPin for AlarmPin {
+        fn set_low(&mut self) -> Result<(), Self::Error> {
+            self.high = false;
+            Ok(())
+        }
+        fn set_high(&mut self) -> Result<(), Self::Error> {
+            self.high = true;
+            Ok(())
+        }
+    }
+
+    fn fail(what: &str) -> ! {
+        defmt::error!("{=str}", what);
+        platform::exit(noback::exit_code::SELFCHECK_FAILED)
+    }
 
     #[entry]
     fn main() -> ! {
-        defmt::info!("noback firmware {=str}", env!("CARGO_PKG_VERSION"));
         let Some(peripherals) = cortex_m::Peripherals::take() else {
-            platform::exit(noback::exit_code::PANIC)
+            fail("peripherals already taken")
         };
-        let meter = Meter::start(peripherals.SYST);
-        // Cost of an empty measurement, to subtract on the host side.
-        let (a, b) = (meter.now(), meter.now());
-        let start = meter.now();
+        let mut bench = false;
+        if let Ok(args) = semihosting::experimental::env::args::<128>() {
+            for arg in args.flatten() {
+                if arg == "bench" {
+                    bench = true;
+                } else if let Some(n) = arg.strip_prefix("overrun-at=") {
+                    OVERRUN_AT.store(n.parse().unwrap_or(u32::MAX), Ordering::Relaxed);
+                }
+            }
+        }
         let report = noback::vectors::run();
-        let end = meter.now();
         defmt::info!(
-            "fx-selfcheck cases={=u32} mismatches={=u32} digest={=u32:#010x} ticks={=u32} overhead={=u32}",
+            "fx-selfcheck cases={=u32} mismatches={=u32} digest={=u32:#010x}",
             report.cases,
             report.mismatches,
-            report.digest,
-            Meter::ticks(start, end),
-            Meter::ticks(a, b)
+            report.digest
         );
-        platform::exit(if report.mismatches == 0 {
-            noback::exit_code::SUCCESS
+        let Ok(replay) = Replay::parse(TRACE) else {
+            fail("the embedded trace is not an NBR1 trace")
+        };
+        let Ok(monitor) = Monitor::new(Config::default()) else {
+            fail("the default monitor configuration was rejected")
+        };
+        defmt::info!(
+            "noback firmware {=str}: {=u32} samples at {=u32} Hz, mode {=str}",
+            env!("CARGO_PKG_VERSION"),
+            replay.len(),
+            replay.tick_hz(),
+            if bench { "bench" } else { "realtime" }
+        );
+        if bench {
+            run_bench(replay, monitor, peripherals.SYST)
         } else {
-            noback::exit_code::SELFCHECK_FAILED
-        })
+            let app = Ticker::new(monitor, replay, AlarmPin { high: false });
+            run_realtime(app, peripherals.SYST)
+        }
+    }
+
+    /// Steps the monitor back to back on the replay, measuring each `Monitor::step` alone (the
+    /// digest and the logging stay outside the measured span). The digest equals the real-time
+    /// run's: both fold every estimate's words in order.
+    fn run_bench(mut replay: Replay<'static>, mut monitor: Monitor, syst: SYST) -> ! {
+        let meter = Meter::start(syst);
+        let (a, b) = (meter.now(), meter.now());
+        let overhead = Meter::ticks(a, b);
+        let (mut sum, mut max, mut steps) = (0_u64, 0_u32, 0_u32);
+        let mut digest = Fnv1a::new();
+        while let Some(inputs) = replay.sample() {
+            let start = meter.now();
+            let estimate = monitor.step(&inputs);
+            let ticks = Meter::ticks(start, meter.now()).saturating_sub(overhead);
+            sum += u64::from(ticks);
+            max = max.max(ticks);
+            steps += 1;
+            digest.push_all(&estimate.to_words());
+        }
+        defmt::info!(
+            "bench steps={=u32} ticks_sum={=u64} ticks_max={=u32} overhead={=u32} stack_bytes={=u32} digest={=u32:#010x}",
+            steps,
+            sum,
+            max,
+            overhead,
+            stack::high_water_bytes(),
+            digest.value()
+        );
+        platform::exit(noback::exit_code::SUCCESS)
+    }
+
+    /// SysTick at 10 kHz drives the ticks; the main loop logs.
+    fn run_realtime(app: App, mut syst: SYST) -> ! {
+        critical_section::with(|cs| APP.borrow(cs).replace(Some(app)));
+        syst.set_clock_source(SystClkSource::Core);
+        syst.set_reload(CLOCK_HZ / TICK_HZ - 1);
+        syst.clear_current();
+        syst.enable_interrupt();
+        syst.enable_counter();
+        loop {
+            let event = critical_section::with(|cs| {
+                APP.borrow(cs)
+                    .borrow_mut()
+                    .as_mut()
+                    .and_then(Ticker::next_event)
+            });
+            match event {
+                Some(event) => log(&event),
+                None if DONE.load(Ordering::Acquire) => break,
+                None => cortex_m::asm::wfi(),
+            }
+        }
+        syst.disable_interrupt();
+        syst.disable_counter();
+        let Some(app) = critical_section::with(|cs| APP.borrow(cs).take()) else {
+            fail("the application state vanished")
+        };
+        finish(&app)
+    }
+
+    fn finish(app: &App) -> ! {
+        let t = app.totals();
+        let last = app.last_estimate();
+        defmt::info!(
+            "summary ticks={=u32} overruns={=u32} missed={=u32} log_overwritten={=u32} alarm_errors={=u32} flags={=u8:#04x} stack_bytes={=u32} digest={=u32:#010x}",
+            t.ticks,
+            t.overruns,
+            t.missed_ticks,
+            t.log_overwritten,
+            t.alarm_errors,
+            last.map_or(0, |e| e.flags.bits()),
+            stack::high_water_bytes(),
+            t.digest
+        );
+        platform::exit(noback::exit_code::SUCCESS)
+    }
+
+    fn log(event: &Event) {
+        match *event {
+            Event::State {
+                tick,
+                scene,
+                brake,
+                pressing_force_bits,
+                braking_torque_bits,
+                flags,
+            } => defmt::info!(
+                "state tick={=u32} scene={=u8} brake={=u8} force_q16={=i32} torque_q16={=i32} flags={=u8:#04x}",
+                tick,
+                scene as u8,
+                brake as u8,
+                pressing_force_bits,
+                braking_torque_bits,
+                flags.bits()
+            ),
+            Event::FlagsChanged { tick, before, now } => defmt::warn!(
+                "flags tick={=u32} before={=u8:#04x} now={=u8:#04x}",
+                tick,
+                before.bits(),
+                now.bits()
+            ),
+            Event::Overrun { tick, missed } => {
+                defmt::warn!("overrun tick={=u32} missed={=u32}", tick, missed)
+            }
+        }
+    }
+
+    #[exception]
+    fn SysTick() {
+        // Load and store, not swap: thumbv6m has no atomic read-modify-write, and only this
+        // handler (which cannot preempt itself) writes ELAPSED.
+        let n = ELAPSED.load(Ordering::Relaxed);
+        ELAPSED.store(1, Ordering::Relaxed);
+        let tick_no = TICK_NO.load(Ordering::Relaxed);
+        TICK_NO.store(tick_no.wrapping_add(1), Ordering::Relaxed);
+        let stepped = critical_section::with(|cs| {
+            APP.borrow(cs)
+                .borrow_mut()
+                .as_mut()
+                .and_then(|app| app.tick(n))
+                .is_some()
+        });
+        if !stepped {
+            DONE.store(true, Ordering::Release);
+        }
+        if tick_no == OVERRUN_AT.load(Ordering::Relaxed) {
+            // Provoked overrun: run on until the next tick is due, then half a period more.
+            while !SCB::is_pendst_pending() {}
+            while SYST::get_current() > CLOCK_HZ / TICK_HZ / 2 {}
+        }
+        // The next SysTick already pending means this handler ran past its deadline.
+        if SCB::is_pendst_pending() {
+            ELAPSED.store(2, Ordering::Relaxed);
+        }
     }
 }
 

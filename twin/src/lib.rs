@@ -1,2 +1,21 @@
-//! The digital twin: the paper's full rotation–translation model in f64, host only.
-//! (Being built under issue 3.)
+//! The digital twin of the no-back brake: the paper's rotation–translation model in f64, host
+//! only, with two readings (`paper` and `physical`, docs/model.md), an error-controlled stiff
+//! integrator with event location, scenes, sensor traces and metrics.
+
+pub mod cli;
+pub mod contact;
+pub mod fault;
+pub mod friction;
+pub mod metrics;
+pub mod model;
+pub mod pack;
+pub mod paper_table;
+pub mod reading;
+pub mod scene;
+pub mod sensing;
+pub mod sim;
+pub mod solver;
+pub mod spring;
+pub mod svg;
+pub mod sweep;
+pub mod trace;

@@ -31,7 +31,7 @@ pub fn ensure_targets() -> Result<(), String> {
     if missing.is_empty() {
         return Ok(());
     }
-    println!("bootstrap: adding rustup targets {}", missing.join(" "));
+    eprintln!("bootstrap: adding rustup targets {}", missing.join(" "));
     shell::run(
         Command::new("rustup")
             .args(["target", "add"])
@@ -56,7 +56,7 @@ pub fn ensure_qemu() -> Result<(), String> {
                 .into(),
         );
     }
-    println!("bootstrap: qemu-system-arm is missing; installing it from Debian's packages");
+    eprintln!("bootstrap: qemu-system-arm is missing; installing it from Debian's packages");
     let quiet = [("DEBIAN_FRONTEND", "noninteractive")];
     shell::run(Command::new("apt-get").arg("update").envs(quiet))?;
     shell::run(

@@ -7,10 +7,13 @@ mod bootstrap;
 mod cores;
 mod defmt_log;
 mod elf_size;
+mod monitor;
 mod opt_level;
 mod qemu;
+mod replay;
 mod run;
 mod shell;
+mod snapshot;
 mod test;
 #[cfg(test)]
 mod tidy;
@@ -21,15 +24,31 @@ use std::process::ExitCode;
 pub const COMMANDS: &[(&str, &str)] = &[
     (
         "run",
-        "build the firmware (release, thumbv7m) and boot it in QEMU, printing its decoded log",
+        "[--scene NAME|FILE] [--core m0|m3|m4f] [--json]: the firmware replays a twin scene at 10 kHz under QEMU",
     ),
     (
         "test",
-        "every test: fmt, clippy, tidy, host tests, target tests under QEMU on M0/M3/M4F",
+        "[--core C] [--bless]: every test: fmt, clippy, tidy, host tests, QEMU tests on M0/M3/M4F",
     ),
     (
         "qemu",
         "ELF [--core m0|m3|m4f] [--timeout S] [--icount SHIFT]: boot an ELF in QEMU, decode defmt (the cargo runner)",
+    ),
+    (
+        "twin",
+        "SCENE|FILE [--reading paper|physical] [--out DIR] [--json]: run the digital twin",
+    ),
+    (
+        "paper",
+        "[--json]: the paper's scenes under both readings; writes docs/paper-comparison.md",
+    ),
+    (
+        "sweep",
+        "pressing-force | PARAM=a..b [--scene S]: design sweeps (CSV + SVG)",
+    ),
+    (
+        "monitor",
+        "SCENE|FILE [--json] [--out DIR]: the monitor against the twin (accuracy, flags, latency)",
     ),
     (
         "opt-level",
@@ -58,6 +77,10 @@ fn main() -> ExitCode {
         "run" => run::main(rest),
         "test" => test::main(rest),
         "qemu" => qemu::main(rest),
+        "twin" => Ok(noback_twin::cli::twin_main(rest)),
+        "paper" => Ok(noback_twin::cli::paper_main(rest)),
+        "sweep" => Ok(noback_twin::sweep::sweep_main(rest)),
+        "monitor" => monitor::main(rest),
         "opt-level" => opt_level::main(rest),
         "bootstrap" => bootstrap::ensure_all().map(|()| 0),
         "-h" | "--help" | "help" => return usage(),

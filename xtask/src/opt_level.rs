@@ -84,6 +84,7 @@ pub fn count_selfcheck(core: Core, elf: &str) -> Result<f64, String> {
         timeout: Duration::from_secs(120),
         extra: qemu::icount(COUNT_SHIFT),
         echo: false,
+        args: Vec::new(),
     })?;
     let field = |name: &str| -> Option<f64> {
         outcome

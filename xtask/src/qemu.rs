@@ -27,6 +27,8 @@ pub struct Boot<'a> {
     pub extra: Vec<String>,
     /// Print decoded lines as they arrive.
     pub echo: bool,
+    /// Arguments the firmware reads over semihosting (after its own name).
+    pub args: Vec<String>,
 }
 
 /// What a boot produced.
@@ -37,13 +39,21 @@ pub struct Outcome {
     pub lines: Vec<String>,
 }
 
-/// The QEMU command line for `core` booting `elf`.
-pub fn command(core: Core, elf: &str, extra: &[String]) -> Command {
+/// The QEMU command line for `core` booting `elf` with semihosting arguments `args`.
+pub fn command(core: Core, elf: &str, extra: &[String], args: &[String]) -> Command {
     let (machine, cpu) = core.machine_cpu();
+    let mut semihosting = String::from("enable=on,target=native");
+    if !args.is_empty() {
+        semihosting.push_str(",arg=firmware");
+        for arg in args {
+            semihosting.push_str(",arg=");
+            semihosting.push_str(arg);
+        }
+    }
     let mut cmd = Command::new("qemu-system-arm");
     cmd.args(["-machine", machine, "-cpu", cpu])
         .args(["-nographic", "-monitor", "none", "-serial", "none"])
-        .args(["-semihosting-config", "enable=on,target=native"])
+        .args(["-semihosting-config", &semihosting])
         .args(extra)
         .args(["-kernel", elf]);
     cmd
@@ -62,7 +72,7 @@ pub fn icount(shift: u32) -> Vec<String> {
 pub fn boot(boot: &Boot<'_>) -> Result<Outcome, String> {
     let elf_bytes = std::fs::read(boot.elf).map_err(|e| format!("reading {}: {e}", boot.elf))?;
     let mut decoder = LogDecoder::from_elf(&elf_bytes)?;
-    let mut child = command(boot.core, boot.elf, &boot.extra)
+    let mut child = command(boot.core, boot.elf, &boot.extra, &boot.args)
         .stdin(Stdio::null())
         .stdout(Stdio::piped())
         .stderr(Stdio::piped())
@@ -177,6 +187,7 @@ pub fn main(args: &[String]) -> Result<i32, String> {
         timeout: Duration::from_secs_f64(timeout),
         extra,
         echo: true,
+        args: Vec::new(),
     })?;
     Ok(outcome.code)
 }

@@ -1,62 +1,344 @@
-//! `cargo xtask run` — the main job: build the firmware in release, boot it in QEMU, print its
-//! decoded defmt log, and check its self-check digest against the host's.
+//! `cargo xtask run` — the main job: the firmware replays a twin scene at 10 kHz under QEMU.
+//!
+//! Steps: run the twin on the scene and convert its sensor trace to `NBR1`; build the firmware
+//! (release) with the trace embedded; boot it in real time (SysTick at 10 kHz, `-icount` at 16
+//! ns an instruction, about a 62 MIPS part) and print its decoded log; boot it again in bench
+//! mode (`-icount` at 1 µs an instruction, for sub-instruction SysTick resolution) to count
+//! instructions per step; run the same replay on the host; and end with a summary — ticks,
+//! overruns, flags with times, estimate against the twin at key moments, instructions per step,
+//! flash, RAM, stack, and whether the firmware's estimates equal the host's bit for bit.
 
 use crate::cores::Core;
 use crate::qemu::{self, Boot, Outcome};
+use crate::replay::{host_run, nbr1, twin_trace};
 use crate::shell::{self, cargo, workspace_root};
-use crate::{bootstrap, test::BOOT_TIMEOUT};
+use crate::{bootstrap, elf_size, test::BOOT_TIMEOUT};
+use noback::monitor::Flags;
+use serde_json::json;
+use std::collections::BTreeMap;
 
-/// Entry: `run [--core m0|m3|m4f]` (default M3 on lm3s6965evb).
-pub fn main(args: &[String]) -> Result<i32, String> {
-    let mut core = Core::M3;
+/// Real-time boot: 2^4 ns = 16 ns per instruction.
+pub const REALTIME_SHIFT: u32 = 4;
+/// Bench boot: 2^10 ns per instruction, 12.8 (M0/M3) or 25.6 (M4F) SysTick ticks each.
+pub const BENCH_SHIFT: u32 = 10;
+
+struct Args {
+    scene: String,
+    core: Core,
+    json: bool,
+    overrun_at: Option<u32>,
+}
+
+fn parse(args: &[String]) -> Result<Args, String> {
+    let mut a = Args {
+        scene: "reverse_load".into(),
+        core: Core::M3,
+        json: false,
+        overrun_at: None,
+    };
     let mut it = args.iter();
     while let Some(arg) = it.next() {
         match arg.as_str() {
-            "--core" => core = Core::parse(it.next().ok_or("--core needs a value")?)?,
-            other => return Err(format!("unknown argument `{other}` (try --core m0|m3|m4f)")),
+            "--core" => a.core = Core::parse(it.next().ok_or("--core needs a value")?)?,
+            "--scene" => a.scene = it.next().ok_or("--scene needs a name or file")?.clone(),
+            "--json" => a.json = true,
+            "--overrun-at" => {
+                a.overrun_at = Some(
+                    it.next()
+                        .and_then(|v| v.parse().ok())
+                        .ok_or("--overrun-at needs a tick number")?,
+                );
+            }
+            other => {
+                return Err(format!(
+                    "unknown argument `{other}` (run [--scene NAME|FILE] [--core m0|m3|m4f] [--json] [--overrun-at TICK])"
+                ))
+            }
         }
     }
-    bootstrap::ensure_all()?;
-    let outcome = build_and_boot(core, true)?;
-    let host = noback::vectors::run().digest;
-    let target = crate::test::digest_in(&outcome.lines)?;
-    println!(
-        "\nsummary: core {} exit {}; fixed-point self-check digest {target:#010x} (host {host:#010x}): {}",
-        core.name(),
-        outcome.code,
-        if target == host { "bit-identical" } else { "DIFFERENT" }
-    );
-    Ok(if outcome.code == 0 && target == host {
-        0
-    } else {
-        1
-    })
+    Ok(a)
 }
 
-/// Builds `noback-fw` for `core` in release and boots it, echoing the decoded log.
-pub fn build_and_boot(core: Core, echo: bool) -> Result<Outcome, String> {
-    shell::run(cargo().args([
-        "build",
-        "--release",
-        "-p",
-        "noback",
-        "--bin",
-        "noback-fw",
-        "--target",
-        core.triple(),
-    ]))?;
+/// `key=value` fields of a decoded log line.
+pub fn fields(line: &str) -> BTreeMap<&str, &str> {
+    line.split_whitespace()
+        .filter_map(|token| token.split_once('='))
+        .collect()
+}
+
+fn field<T: std::str::FromStr>(line: &BTreeMap<&str, &str>, key: &str) -> Result<T, String> {
+    let raw = line
+        .get(key)
+        .ok_or_else(|| format!("no `{key}=` in the firmware's line"))?;
+    let raw = raw.trim_start_matches("0x");
+    raw.parse()
+        .or_else(|_| {
+            u64::from_str_radix(raw, 16)
+                .map_err(|_| ())
+                .and_then(|v| v.to_string().parse().map_err(|_| ()))
+        })
+        .map_err(|()| format!("`{key}={raw}` is not a number"))
+}
+
+fn hex(line: &BTreeMap<&str, &str>, key: &str) -> Result<u32, String> {
+    let raw = line
+        .get(key)
+        .ok_or_else(|| format!("no `{key}=` in the firmware's line"))?;
+    u32::from_str_radix(raw.trim_start_matches("0x"), 16)
+        .map_err(|_| format!("`{key}={raw}` is not hex"))
+}
+
+/// The line of `lines` whose message starts with `word`.
+fn line_with<'a>(lines: &'a [String], word: &str) -> Result<BTreeMap<&'a str, &'a str>, String> {
+    lines
+        .iter()
+        .find(|l| l.split_whitespace().nth(1) == Some(word))
+        .map(|l| fields(l))
+        .ok_or_else(|| format!("the firmware printed no `{word}` line"))
+}
+
+fn flag_names(bits: u8) -> Vec<&'static str> {
+    let f = Flags::from_bits(bits);
+    [
+        (f.brake_slip, "brake_slip"),
+        (f.brake_weak, "brake_weak"),
+        (f.brake_drag, "brake_drag"),
+        (f.sensor_fault, "sensor_fault"),
+        (f.overrun, "overrun"),
+    ]
+    .into_iter()
+    .filter_map(|(on, name)| on.then_some(name))
+    .collect()
+}
+
+/// Entry.
+pub fn main(args: &[String]) -> Result<i32, String> {
+    let a = parse(args)?;
+    bootstrap::ensure_all()?;
+    let (report, ok) = replay_report(&a.scene, a.core, a.overrun_at, !a.json)?;
+    if a.json {
+        println!("{report}");
+    } else {
+        print_summary(&report);
+    }
+    Ok(if ok { 0 } else { 1 })
+}
+
+/// Runs a scene through the firmware under QEMU and the host; returns the summary and whether
+/// the run was good (clean exits, bit-exact).
+pub fn replay_report(
+    scene: &str,
+    core: Core,
+    overrun_at: Option<u32>,
+    echo: bool,
+) -> Result<(serde_json::Value, bool), String> {
+    if echo {
+        println!("twin: scene `{}` (physical reading)", scene);
+    }
+    let trace = twin_trace(scene)?;
+    let bytes = nbr1(&trace)?;
+    let dir = workspace_root().join("target").join("replay");
+    std::fs::create_dir_all(&dir).map_err(|e| e.to_string())?;
+    let stem = std::path::Path::new(&scene)
+        .file_stem()
+        .map_or("scene".into(), |s| s.to_string_lossy().into_owned());
+    let replay_path = dir.join(format!("{stem}.nbr1"));
+    std::fs::write(&replay_path, &bytes).map_err(|e| e.to_string())?;
+    if echo {
+        println!(
+            "replay: {} samples, {} bytes -> {}",
+            trace.rows.len(),
+            bytes.len(),
+            replay_path.display()
+        );
+    }
+
+    let elf = build(core, &replay_path)?;
+    let mut rt_args = vec!["realtime".to_string()];
+    if let Some(n) = overrun_at {
+        rt_args.push(format!("overrun-at={n}"));
+    }
+    let realtime = boot(core, &elf, REALTIME_SHIFT, rt_args, echo)?;
+    let bench = boot(core, &elf, BENCH_SHIFT, vec!["bench".into()], false)?;
+
+    let summary = line_with(&realtime.lines, "summary")?;
+    let bench_line = line_with(&bench.lines, "bench")?;
+    let overruns: Vec<(u32, u32)> = realtime
+        .lines
+        .iter()
+        .filter(|l| l.split_whitespace().nth(1) == Some("overrun"))
+        .map(|l| {
+            let f = fields(l);
+            Ok((field(&f, "tick")?, field(&f, "missed")?))
+        })
+        .collect::<Result<_, String>>()?;
+    let host = host_run(&bytes, &overruns)?;
+    let host_plain = host_run(&bytes, &[])?;
+    let fw_digest = hex(&summary, "digest")?;
+    let bench_digest = hex(&bench_line, "digest")?;
+    let bit_exact = fw_digest == host.totals.digest && bench_digest == host_plain.totals.digest;
+
+    let ticks: u32 = field(&summary, "ticks")?;
+    let steps: f64 = field::<u32>(&bench_line, "steps")?.into();
+    let ticks_sum: f64 = field::<u64>(&bench_line, "ticks_sum")? as f64;
+    let ticks_max: f64 = field::<u32>(&bench_line, "ticks_max")?.into();
+    let per_insn = core.ticks_per_insn(BENCH_SHIFT);
+    let insns_mean = ticks_sum / steps.max(1.0) / per_insn;
+    let insns_max = ticks_max / per_insn;
+    let size = elf_size::of_file(&elf)?;
+    let flash_bytes = size.flash_bytes.saturating_sub(bytes.len() as u64);
+    let stack_bytes: u32 = field(&summary, "stack_bytes")?;
+
+    let flags: Vec<_> =
+        realtime
+            .lines
+            .iter()
+            .filter(|l| l.split_whitespace().nth(1) == Some("flags"))
+            .filter_map(|l| {
+                let f = fields(l);
+                let tick: u32 = field(&f, "tick").ok()?;
+                let before = hex(&f, "before").ok()? as u8;
+                let now = hex(&f, "now").ok()? as u8;
+                Some(flag_names(now & !before).into_iter().map(
+                    move |name| json!({"flag": name, "tick": tick, "t_s": f64::from(tick) / 1e4}),
+                ))
+            })
+            .flatten()
+            .collect();
+
+    // The estimate against the twin's truth every 0.1 s, from the host run (bit-identical to
+    // the firmware's when bit_exact holds).
+    let moments: Vec<_> = host
+        .estimates
+        .iter()
+        .zip(&trace.rows)
+        .step_by(1000)
+        .map(|(e, row)| {
+            json!({
+                "t_s": row.t_s,
+                "scene": format!("{:?}", e.scene),
+                "brake": format!("{:?}", e.brake),
+                "pressing_force_n": e.pressing_force_n.to_num::<f64>(),
+                "twin_pressing_force_n": row.pressing_force_n,
+                "braking_torque_nm": e.braking_torque_nm.to_num::<f64>(),
+                "twin_braking_torque_nm": row.braking_torque_nm,
+            })
+        })
+        .collect();
+
+    let report = json!({
+        "scene": scene,
+        "core": core.name(),
+        "exit_code": realtime.code,
+        "ticks": ticks,
+        "overruns": field::<u32>(&summary, "overruns")?,
+        "missed_ticks": field::<u32>(&summary, "missed")?,
+        "log_overwritten": field::<u32>(&summary, "log_overwritten")?,
+        "flags": flags,
+        "insns_per_step_mean": (insns_mean * 10.0).round() / 10.0,
+        "insns_per_step_max": insns_max.round(),
+        "flash_bytes": flash_bytes,
+        "replay_bytes": bytes.len(),
+        "ram_bytes": size.ram_bytes,
+        "stack_bytes_max": stack_bytes,
+        "bit_exact": bit_exact,
+        "firmware_digest": format!("{fw_digest:#010x}"),
+        "fx_selfcheck_digest": format!("{:#010x}", crate::test::digest_in(&realtime.lines)?),
+        "host_digest": format!("{:#010x}", host.totals.digest),
+        "key_moments": moments,
+    });
+    let ok = realtime.code == 0 && bench.code == 0 && bit_exact;
+    Ok((report, ok))
+}
+
+fn print_summary(r: &serde_json::Value) {
+    println!("\n=== summary ({} on {}) ===", r["scene"], r["core"]);
+    println!(
+        "ticks {}  overruns {} (missed ticks {})  log events overwritten {}",
+        r["ticks"], r["overruns"], r["missed_ticks"], r["log_overwritten"]
+    );
+    let flags = r["flags"].as_array().cloned().unwrap_or_default();
+    if flags.is_empty() {
+        println!("flags: none");
+    }
+    for f in flags {
+        println!(
+            "flag {} raised at t = {} s (tick {})",
+            f["flag"], f["t_s"], f["tick"]
+        );
+    }
+    println!(
+        "instructions per step: mean {}, max {} (QEMU -icount, bench boot)",
+        r["insns_per_step_mean"], r["insns_per_step_max"]
+    );
+    println!(
+        "flash {} B (+ {} B replay data), static RAM {} B, stack high-water {} B",
+        r["flash_bytes"], r["replay_bytes"], r["ram_bytes"], r["stack_bytes_max"]
+    );
+    println!("     t_s  scene          brake      force N  (twin)   torque N·m (twin)");
+    for m in r["key_moments"].as_array().cloned().unwrap_or_default() {
+        println!(
+            "{:>8.3}  {:<13} {:<9} {:>8.1} ({:>7.1}) {:>8.2} ({:>7.2})",
+            m["t_s"].as_f64().unwrap_or(f64::NAN),
+            m["scene"].as_str().unwrap_or(""),
+            m["brake"].as_str().unwrap_or(""),
+            m["pressing_force_n"].as_f64().unwrap_or(f64::NAN),
+            m["twin_pressing_force_n"].as_f64().unwrap_or(f64::NAN),
+            m["braking_torque_nm"].as_f64().unwrap_or(f64::NAN),
+            m["twin_braking_torque_nm"].as_f64().unwrap_or(f64::NAN),
+        );
+    }
+    println!(
+        "bit-exact against the host: {} (firmware {}, host {})",
+        r["bit_exact"], r["firmware_digest"], r["host_digest"]
+    );
+}
+
+/// Builds the firmware for `core` in release with `replay` embedded; returns the ELF path.
+pub fn build(core: Core, replay: &std::path::Path) -> Result<String, String> {
+    shell::run(
+        cargo()
+            .args(["build", "--release", "-p", "noback", "--bin", "noback-fw"])
+            .args(["--target", core.triple()])
+            .env("NOBACK_REPLAY", replay),
+    )?;
     let elf = workspace_root()
         .join("target")
         .join(core.triple())
         .join("release")
         .join("noback-fw");
-    let elf = elf.to_string_lossy();
-    println!("$ {}", shell::describe(&qemu::command(core, &elf, &[])));
-    qemu::boot(&Boot {
-        elf: &elf,
+    Ok(elf.to_string_lossy().into_owned())
+}
+
+/// Boots the firmware once.
+pub fn boot(
+    core: Core,
+    elf: &str,
+    shift: u32,
+    args: Vec<String>,
+    echo: bool,
+) -> Result<Outcome, String> {
+    let extra = qemu::icount(shift);
+    if echo {
+        println!(
+            "$ {}",
+            shell::describe(&qemu::command(core, elf, &extra, &args))
+        );
+    }
+    let outcome = qemu::boot(&Boot {
+        elf,
         core,
         timeout: BOOT_TIMEOUT,
-        extra: Vec::new(),
+        extra,
         echo,
-    })
+        args,
+    })?;
+    if outcome.code != 0 {
+        return Err(format!(
+            "the firmware exited with code {} on {}",
+            outcome.code,
+            core.name()
+        ));
+    }
+    Ok(outcome)
 }

@@ -36,7 +36,7 @@ pub fn describe(cmd: &Command) -> String {
 /// Runs `cmd` with inherited stdio, printing it first; an error names it if it fails.
 pub fn run(cmd: &mut Command) -> Result<(), Error> {
     let text = describe(cmd);
-    println!("$ {text}");
+    eprintln!("$ {text}");
     let status = cmd
         .status()
         .map_err(|e| format!("could not start `{text}`: {e}"))?;
@@ -59,7 +59,7 @@ pub fn built_executables(cmd: &mut Command) -> Result<Vec<(String, String)>, Err
     cmd.args(["--message-format", "json-render-diagnostics"])
         .stdout(std::process::Stdio::piped());
     let text = describe(cmd);
-    println!("$ {text}");
+    eprintln!("$ {text}");
     let out = cmd
         .output()
         .map_err(|e| format!("could not start `{text}`: {e}"))?;

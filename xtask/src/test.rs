@@ -6,18 +6,24 @@
 
 use crate::bootstrap;
 use crate::cores::Core;
-use crate::qemu;
 use crate::shell::{self, cargo};
+use crate::{qemu, run, snapshot};
 use std::io::{BufRead, BufReader};
 use std::process::Stdio;
 use std::time::{Duration, Instant};
 
-/// Entry: `test [--core m0|m3|m4f]…` (default: all three cores).
+/// The scene whose QEMU run is the snapshot test: the paper's reverse-load motor failure.
+pub const SNAPSHOT_SCENE: &str = "reverse_load";
+
+/// Entry: `test [--core m0|m3|m4f]… [--bless]` (default: all three cores; `--bless` rewrites
+/// the QEMU snapshot instead of comparing with it).
 pub fn main(args: &[String]) -> Result<i32, String> {
     let mut cores = Vec::new();
+    let mut bless = false;
     let mut it = args.iter();
     while let Some(arg) = it.next() {
         match arg.as_str() {
+            "--bless" => bless = true,
             "--core" => cores.push(Core::parse(it.next().ok_or("--core needs a value")?)?),
             other => return Err(format!("unknown argument `{other}` (try --core m0|m3|m4f)")),
         }
@@ -56,6 +62,20 @@ pub fn main(args: &[String]) -> Result<i32, String> {
             "warnings",
         ]))?;
     }
+    for &core in &cores {
+        section(&format!(
+            "panic-never proof: link the real-time path ({})",
+            core.triple()
+        ));
+        shell::run(cargo().args([
+            "build",
+            "--release",
+            "-p",
+            "panic-check",
+            "--target",
+            core.triple(),
+        ]))?;
+    }
     section("host tests (library, host-tests, twin, xtask tidy)");
     shell::run(cargo().args(["test", "--workspace"]))?;
 
@@ -67,16 +87,38 @@ pub fn main(args: &[String]) -> Result<i32, String> {
         let test_digest = digest_in(&lines)?;
         section(&format!("fault probes under QEMU ({})", core.name()));
         fault_probes(core)?;
-        section(&format!("firmware under QEMU ({}, release)", core.name()));
-        let fw = crate::run::build_and_boot(core, true)?;
-        if fw.code != 0 {
+        section(&format!(
+            "firmware replaying `{SNAPSHOT_SCENE}` under QEMU ({}, release)",
+            core.name()
+        ));
+        let (report, ok) = run::replay_report(SNAPSHOT_SCENE, core, None, false)?;
+        println!(
+            "ticks {}, overruns {}, flags {}, {} instructions/step max, bit-exact {}",
+            report["ticks"],
+            report["overruns"],
+            report["flags"],
+            report["insns_per_step_max"],
+            report["bit_exact"]
+        );
+        if !ok {
             return Err(format!(
-                "firmware on {} exited with {}",
-                core.name(),
-                fw.code
+                "the firmware on {} is not bit-exact with the host or exited badly",
+                core.name()
             ));
         }
-        let fw_digest = digest_in(&fw.lines)?;
+        if core == Core::M3 {
+            snapshot::check(&report, bless)?;
+            section("provoked overrun (m3)");
+            overrun_is_counted_and_flagged()?;
+        }
+        let fw_digest = u32::from_str_radix(
+            report["fx_selfcheck_digest"]
+                .as_str()
+                .unwrap_or("")
+                .trim_start_matches("0x"),
+            16,
+        )
+        .map_err(|e| format!("self-check digest: {e}"))?;
         rows.push((core, test_digest, fw_digest));
     }
 
@@ -142,6 +184,33 @@ fn target_tests(core: Core) -> Result<Vec<String>, String> {
     Ok(lines)
 }
 
+/// Tick at which the overrun test makes the interrupt miss its deadline.
+const OVERRUN_TICK: u32 = 3000;
+
+/// Provokes one missed deadline and checks it is counted, flagged and replayed identically.
+fn overrun_is_counted_and_flagged() -> Result<(), String> {
+    let (report, ok) = run::replay_report(SNAPSHOT_SCENE, Core::M3, Some(OVERRUN_TICK), false)?;
+    let overruns = report["overruns"].as_u64().unwrap_or(0);
+    let flagged = report["flags"]
+        .as_array()
+        .into_iter()
+        .flatten()
+        .find(|f| f["flag"] == "overrun")
+        .and_then(|f| f["tick"].as_u64());
+    println!(
+        "overrun at tick {OVERRUN_TICK}: counted {overruns}, missed {}, flag raised at tick {flagged:?}, bit-exact {}",
+        report["missed_ticks"], report["bit_exact"]
+    );
+    // The interrupt with index OVERRUN_TICK (0-based) overruns; the next one is late and steps
+    // the monitor by two ticks, so its tick counter reads OVERRUN_TICK + 1 + 2.
+    let flag_in_time = flagged == Some(u64::from(OVERRUN_TICK) + 3);
+    if overruns == 1 && flag_in_time && ok {
+        Ok(())
+    } else {
+        Err("the provoked overrun was not counted once, flagged on the next tick and replayed bit-exactly".into())
+    }
+}
+
 /// Boots the three fault probes and checks each ends with its own non-zero exit code.
 fn fault_probes(core: Core) -> Result<(), String> {
     let expected = [
@@ -167,6 +236,7 @@ fn fault_probes(core: Core) -> Result<(), String> {
             timeout: Duration::from_secs(3),
             extra: Vec::new(),
             echo: false,
+            args: Vec::new(),
         })?;
         let verdict = if outcome.code == code { "ok" } else { "WRONG" };
         println!(

@@ -1,0 +1,268 @@
+//! The monitor against the twin: run the shipped monitor over a twin trace and measure how far
+//! its estimates are from the twin's truth, and when its flags come.
+//!
+//! The monitor does not model the ball–socket contact impacts on purpose (they ring at hundreds
+//! of hertz and carry no braking information), so the twin's pressing force and braking torque
+//! are compared after a centred moving average over [`COMPARE_WINDOW_S`] — the "compared"
+//! signal. Both the raw and the compared truth are kept, and the plot shows both.
+//! Definitions (also in docs/monitor.md):
+//! - pressing-force RMS error: over every sample, monitor − compared twin; in % of the compared
+//!   twin's peak.
+//! - braking-torque RMS error: |monitor| − compared twin magnitude.
+//! - holding torque: mean braking torque over the last [`HOLD_WINDOW_S`] when both say locked.
+//! - lock time: first sample after the drive is cut at which the brake state is locked and
+//!   stays locked for [`LOCK_CONFIRM_S`].
+
+use noback::monitor::{BrakeState, Config, Estimate, Flags, Inputs, Monitor};
+use noback_twin::fault::{Fault, FaultKind};
+use noback_twin::trace::Trace;
+
+/// Width of the centred moving average applied to the twin's truth (s).
+pub const COMPARE_WINDOW_S: f64 = 0.010;
+/// Window at the end of a run over which holding torque is averaged (s).
+pub const HOLD_WINDOW_S: f64 = 0.050;
+/// How long a lock must last to count (s).
+pub const LOCK_CONFIRM_S: f64 = 0.020;
+
+/// Runs the monitor over every row of a trace.
+pub fn run_monitor(trace: &Trace, config: Config) -> Result<Vec<Estimate>, String> {
+    let mut monitor = Monitor::new(config).map_err(|e| format!("monitor config: {e:?}"))?;
+    Ok(trace
+        .rows
+        .iter()
+        .map(|r| {
+            monitor.step(&Inputs::new(
+                r.current_code,
+                r.motor_count,
+                r.output_count,
+                r.drive_on,
+            ))
+        })
+        .collect())
+}
+
+/// Centred moving average over `window` samples (shrinking at the ends).
+pub fn smooth(x: &[f64], window: usize) -> Vec<f64> {
+    let half = window / 2;
+    let mut prefix = Vec::with_capacity(x.len() + 1);
+    prefix.push(0.0);
+    for v in x {
+        prefix.push(prefix.last().copied().unwrap_or(0.0) + v);
+    }
+    (0..x.len())
+        .map(|i| {
+            let lo = i.saturating_sub(half);
+            let hi = (i + half + 1).min(x.len());
+            (prefix[hi] - prefix[lo]) / (hi - lo) as f64
+        })
+        .collect()
+}
+
+fn rms(a: &[f64], b: &[f64]) -> f64 {
+    let n = a.len().min(b.len()).max(1) as f64;
+    (a.iter().zip(b).map(|(x, y)| (x - y).powi(2)).sum::<f64>() / n).sqrt()
+}
+
+/// One raised flag.
+#[derive(Clone, Debug, PartialEq)]
+pub struct FlagEvent {
+    /// Flag name.
+    pub flag: &'static str,
+    /// Time (s).
+    pub t_s: f64,
+}
+
+/// The comparison of one run.
+#[derive(Clone, Debug)]
+pub struct Accuracy {
+    /// Time of each sample (s).
+    pub t_s: Vec<f64>,
+    /// Twin pressing force, raw and compared (N).
+    pub twin_force_raw_n: Vec<f64>,
+    /// Twin pressing force after the moving average (N).
+    pub twin_force_n: Vec<f64>,
+    /// Monitor pressing force (N).
+    pub monitor_force_n: Vec<f64>,
+    /// Twin braking torque, raw (N·m).
+    pub twin_torque_raw_nm: Vec<f64>,
+    /// Twin braking torque after the moving average (N·m).
+    pub twin_torque_nm: Vec<f64>,
+    /// Monitor braking torque magnitude (N·m).
+    pub monitor_torque_nm: Vec<f64>,
+    /// RMS pressing-force error (N).
+    pub pressing_force_rmse_n: f64,
+    /// The same in % of the compared twin's peak.
+    pub pressing_force_rmse_pct: f64,
+    /// RMS braking-torque error (N·m).
+    pub braking_torque_rmse_nm: f64,
+    /// Holding torque: twin, monitor (N·m), if both end locked.
+    pub holding_torque_nm: Option<(f64, f64)>,
+    /// Lock time after the drive cut: twin, monitor (s), if both lock.
+    pub lock_time_s: Option<(f64, Option<f64>)>,
+    /// Flags as they were raised.
+    pub flags: Vec<FlagEvent>,
+}
+
+impl Accuracy {
+    /// Holding-torque error in % of the twin's.
+    pub fn holding_torque_err_pct(&self) -> Option<f64> {
+        self.holding_torque_nm
+            .map(|(twin, mon)| 100.0 * (mon - twin).abs() / twin.abs().max(1e-9))
+    }
+
+    /// Lock-time error (s); `None` when the twin does not lock, infinite when only the monitor
+    /// misses it.
+    pub fn lock_time_err_s(&self) -> Option<f64> {
+        self.lock_time_s
+            .map(|(twin, mon)| mon.map_or(f64::INFINITY, |m| (m - twin).abs()))
+    }
+}
+
+fn flag_list(f: Flags) -> [(bool, &'static str); 5] {
+    [
+        (f.brake_slip, "brake_slip"),
+        (f.brake_weak, "brake_weak"),
+        (f.brake_drag, "brake_drag"),
+        (f.sensor_fault, "sensor_fault"),
+        (f.overrun, "overrun"),
+    ]
+}
+
+/// First time after `from` at which `locked(i)` holds for [`LOCK_CONFIRM_S`].
+fn lock_time(t: &[f64], from: f64, locked: impl Fn(usize) -> bool) -> Option<f64> {
+    let mut start: Option<usize> = None;
+    for i in 0..t.len() {
+        if t[i] < from || !locked(i) {
+            start = None;
+            continue;
+        }
+        let s = *start.get_or_insert(i);
+        if t[i] - t[s] >= LOCK_CONFIRM_S {
+            return Some(t[s]);
+        }
+    }
+    None
+}
+
+/// Compares the monitor's estimates with the trace's truth.
+pub fn compare(trace: &Trace, estimates: &[Estimate]) -> Accuracy {
+    let rows = &trace.rows;
+    let window = (COMPARE_WINDOW_S * trace.sample_rate_hz).round().max(1.0) as usize;
+    let t_s: Vec<f64> = rows.iter().map(|r| r.t_s).collect();
+    let twin_force_raw_n: Vec<f64> = rows.iter().map(|r| r.pressing_force_n).collect();
+    let twin_torque_raw_nm: Vec<f64> = rows.iter().map(|r| r.braking_torque_nm.abs()).collect();
+    let twin_force_n = smooth(&twin_force_raw_n, window);
+    let twin_torque_nm = smooth(&twin_torque_raw_nm, window);
+    let monitor_force_n: Vec<f64> = estimates
+        .iter()
+        .map(|e| e.pressing_force_n.to_num::<f64>())
+        .collect();
+    let monitor_torque_nm: Vec<f64> = estimates
+        .iter()
+        .map(|e| e.braking_torque_nm.to_num::<f64>().abs())
+        .collect();
+    let pressing_force_rmse_n = rms(&monitor_force_n, &twin_force_n);
+    let peak = twin_force_n.iter().cloned().fold(0.0, f64::max).max(1e-9);
+    let braking_torque_rmse_nm = rms(&monitor_torque_nm, &twin_torque_nm);
+
+    let hold = (HOLD_WINDOW_S * trace.sample_rate_hz) as usize;
+    let n = rows.len().min(estimates.len());
+    let tail = n.saturating_sub(hold)..n;
+    let both_locked = n > hold
+        && tail
+            .clone()
+            .all(|i| rows[i].brake_state == 2 && estimates[i].brake == BrakeState::Locked);
+    let mean = |x: &[f64]| x[tail.clone()].iter().sum::<f64>() / hold.max(1) as f64;
+    let holding_torque_nm =
+        both_locked.then(|| (mean(&twin_torque_raw_nm), mean(&monitor_torque_nm)));
+
+    let cut = rows
+        .windows(2)
+        .find(|w| w[0].drive_on && !w[1].drive_on)
+        .map(|w| w[1].t_s)
+        .or_else(|| rows.first().filter(|r| !r.drive_on).map(|r| r.t_s));
+    let lock_time_s = cut.and_then(|from| {
+        let twin = lock_time(&t_s, from, |i| rows[i].brake_state == 2)?;
+        Some((
+            twin,
+            lock_time(&t_s[..n], from, |i| {
+                estimates[i].brake == BrakeState::Locked
+            }),
+        ))
+    });
+
+    let mut flags = Vec::new();
+    let mut before = Flags::default();
+    for (e, r) in estimates.iter().zip(rows) {
+        for ((now, name), (was, _)) in flag_list(e.flags).into_iter().zip(flag_list(before)) {
+            if now && !was {
+                flags.push(FlagEvent {
+                    flag: name,
+                    t_s: r.t_s,
+                });
+            }
+        }
+        before = e.flags;
+    }
+
+    Accuracy {
+        t_s,
+        twin_force_raw_n,
+        twin_force_n,
+        monitor_force_n,
+        twin_torque_raw_nm,
+        twin_torque_nm,
+        monitor_torque_nm,
+        pressing_force_rmse_n,
+        pressing_force_rmse_pct: 100.0 * pressing_force_rmse_n / peak,
+        braking_torque_rmse_nm,
+        holding_torque_nm,
+        lock_time_s,
+        flags,
+    }
+}
+
+/// The flag that must answer a fault of this kind.
+pub fn expected_flag(kind: FaultKind) -> &'static [&'static str] {
+    match kind {
+        FaultKind::FrictionLoss | FaultKind::PackWear | FaultKind::SpringBroken => {
+            &["brake_weak", "brake_slip"]
+        }
+        FaultKind::RampJam => &["brake_weak", "brake_slip", "brake_drag"],
+        FaultKind::Drag => &["brake_drag"],
+        FaultKind::EncoderStuck | FaultKind::EncoderJump | FaultKind::CurrentOpen => {
+            &["sensor_fault"]
+        }
+    }
+}
+
+/// When a fault shows in what the monitor can observe: sensor faults at once; brake-holding
+/// faults when the brake is next asked to hold (drive off at or after the onset); drag when
+/// the drive next runs.
+pub fn manifest_time(fault: &Fault, trace: &Trace) -> Option<f64> {
+    let after = trace.rows.iter().filter(|r| r.t_s >= fault.at_s);
+    match fault.kind {
+        FaultKind::EncoderStuck | FaultKind::EncoderJump | FaultKind::CurrentOpen => {
+            Some(fault.at_s)
+        }
+        FaultKind::Drag => after.clone().find(|r| r.drive_on).map(|r| r.t_s),
+        _ => after.clone().find(|r| !r.drive_on).map(|r| r.t_s),
+    }
+}
+
+/// Detection latency of a fault (s): first expected flag at or after it manifests.
+pub fn detection_latency_s(fault: &Fault, trace: &Trace, acc: &Accuracy) -> Option<f64> {
+    let at = manifest_time(fault, trace)?;
+    acc.flags
+        .iter()
+        .filter(|f| expected_flag(fault.kind).contains(&f.flag))
+        .map(|f| f.t_s - at)
+        .find(|dt| *dt >= -1e-9)
+}
+
+/// Flags raised before the first fault's onset (all of them in a fault-free run), `overrun`
+/// excluded (a host replay never misses a tick).
+pub fn false_alarms(faults: &[Fault], acc: &Accuracy) -> usize {
+    let first = faults.iter().map(|f| f.at_s).fold(f64::INFINITY, f64::min);
+    acc.flags.iter().filter(|f| f.t_s < first).count()
+}

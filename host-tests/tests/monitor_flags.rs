@@ -1,0 +1,413 @@
+//! Flag logic, encoder wrap, missed ticks and constructor errors of the monitor, on hand-built
+//! input streams.
+
+use noback::monitor::{
+    BrakeState, Config, ConfigError, Estimate, Flags, Inputs, Monitor, ObserverGains, Scene,
+    ESTIMATE_WORDS,
+};
+
+const MID: u16 = 2048;
+
+fn at_rest(monitor: &mut Monitor, out: u32, motor: u32, ticks: u32) -> Estimate {
+    let mut e = monitor.step(&Inputs::new(MID, motor, out, false));
+    for _ in 1..ticks {
+        e = monitor.step(&Inputs::new(MID, motor, out, false));
+    }
+    e
+}
+
+#[test]
+fn power_on_at_rest_locks_without_flags() {
+    let mut m = Monitor::new(Config::default()).unwrap();
+    let e = at_rest(&mut m, 1234, 555, 500);
+    assert_eq!(e.brake, BrakeState::Locked);
+    assert_eq!(e.scene, Scene::Holding);
+    assert!(!e.flags.any());
+    // The load has never been observed: the estimate says so.
+    assert!(!e.trusted);
+    assert_eq!(e.tick, 500);
+}
+
+#[test]
+fn out_of_range_adc_code_latches_sensor_fault_until_reset() {
+    let mut m = Monitor::new(Config::default()).unwrap();
+    at_rest(&mut m, 0, 0, 100);
+    let e = m.step(&Inputs::new(4096, 0, 0, false)); // a 12-bit ADC cannot produce it
+    assert!(e.flags.sensor_fault);
+    assert!(!e.trusted);
+    // Latched: good readings do not clear it.
+    let e = at_rest(&mut m, 0, 0, 2000);
+    assert!(e.flags.sensor_fault);
+    assert_eq!(e.flags.bits(), 0b0_1000);
+    m.reset_flags();
+    let e = at_rest(&mut m, 0, 0, 10);
+    assert!(!e.flags.any());
+    // And it comes back if the condition does.
+    let e = m.step(&Inputs::new(u16::MAX, 0, 0, false));
+    assert!(e.flags.sensor_fault);
+}
+
+#[test]
+fn adc_stuck_at_a_rail_is_a_sensor_fault_but_a_single_rail_sample_is_not() {
+    let mut m = Monitor::new(Config::default()).unwrap();
+    at_rest(&mut m, 0, 0, 100);
+    let e = m.step(&Inputs::new(0, 0, 0, true));
+    assert!(!e.flags.sensor_fault);
+    let mut e = e;
+    for _ in 0..30 {
+        e = m.step(&Inputs::new(0, 0, 0, true));
+    }
+    assert!(e.flags.sensor_fault);
+}
+
+#[test]
+fn current_with_the_drive_off_is_implausible() {
+    let mut m = Monitor::new(Config::default()).unwrap();
+    at_rest(&mut m, 0, 0, 100);
+    // 5 A with the drive off (3 A allowed): 5/(50/4096) ≈ 410 counts.
+    let e = m.step(&Inputs::new(MID + 410, 0, 0, false));
+    assert!(e.flags.sensor_fault);
+    let mut m = Monitor::new(Config::default()).unwrap();
+    at_rest(&mut m, 0, 0, 100);
+    let e = m.step(&Inputs::new(MID + 200, 0, 0, false)); // 2.4 A: within the allowance
+    assert!(!e.flags.sensor_fault);
+}
+
+#[test]
+fn output_encoder_wrap_is_motion_not_a_jump() {
+    // Creep across the 14-bit wrap at 0.77 rad/s (2 counts every 10 ticks) with the drive on.
+    let mut m = Monitor::new(Config::default()).unwrap();
+    let mut out: u32 = 16_300;
+    let mut motor: u32 = 65_000;
+    let mut e = m.step(&Inputs::new(MID, motor, out, true));
+    for k in 0..3000_u32 {
+        if k % 10 == 0 {
+            out = (out + 2) & 0x3FFF;
+        }
+        // 2 output counts ≈ 15 motor counts: 1.5 counts per tick, starting near the 16-bit wrap.
+        motor = (motor + 1 + k % 2) & 0xFFFF;
+        e = m.step(&Inputs::new(MID, motor, out, true));
+    }
+    assert!(motor < 65_000, "the motor counter wrapped");
+    assert!(out < 16_300, "the trace wrapped");
+    assert!(!e.flags.sensor_fault, "{:?}", e.flags);
+    let speed = e.output_speed_rad_s.to_num::<f64>();
+    let want = 2.0 * core::f64::consts::TAU / 16_384.0 / 10.0 * 10_000.0;
+    assert!((speed - want).abs() < 0.05 * want, "{speed} vs {want}");
+    let input = e.input_speed_rad_s.to_num::<f64>();
+    let want_in = 15.0 * core::f64::consts::TAU / (4096.0 * 30.0) / 10.0 * 10_000.0;
+    assert!(
+        (input - want_in).abs() < 0.1 * want_in,
+        "{input} vs {want_in}"
+    );
+}
+
+#[test]
+fn output_encoder_jump_is_a_sensor_fault_and_a_glitch_leaves_no_brake_flag() {
+    let mut m = Monitor::new(Config::default()).unwrap();
+    at_rest(&mut m, 8000, 0, 2000);
+    // One corrupted sample 3000 counts away, then back.
+    let e = m.step(&Inputs::new(MID, 0, 11_000, false));
+    assert!(e.flags.sensor_fault);
+    let e = at_rest(&mut m, 8000, 0, 3000);
+    assert_eq!(
+        e.flags,
+        Flags {
+            sensor_fault: true,
+            ..Flags::default()
+        }
+    );
+    assert_eq!(e.brake, BrakeState::Locked);
+    assert!(e.output_speed_rad_s.abs().to_num::<f64>() < 0.01);
+}
+
+#[test]
+fn counter_bits_above_the_register_width_are_implausible() {
+    let mut m = Monitor::new(Config::default()).unwrap();
+    at_rest(&mut m, 0, 0, 10);
+    assert!(
+        m.step(&Inputs::new(MID, 0, 1 << 14, false))
+            .flags
+            .sensor_fault
+    );
+    let mut m = Monitor::new(Config::default()).unwrap();
+    at_rest(&mut m, 0, 0, 10);
+    assert!(
+        m.step(&Inputs::new(MID, 1 << 16, 0, false))
+            .flags
+            .sensor_fault
+    );
+}
+
+#[test]
+fn stuck_output_encoder_while_driving_is_detected() {
+    // Drive on, motor turning at 100 rad/s motor side, output counter frozen.
+    let mut m = Monitor::new(Config::default()).unwrap();
+    let mut motor: u32 = 0;
+    let mut e = m.step(&Inputs::new(MID + 100, motor, 5, true));
+    for _ in 0..20_000 {
+        motor = (motor + 7) & 0xFFFF; // 7 counts/tick = 107 rad/s at the motor
+        e = m.step(&Inputs::new(MID + 100, motor, 5, true));
+        if e.flags.sensor_fault {
+            break;
+        }
+    }
+    assert!(e.flags.sensor_fault);
+    // Lost motion limit 2 rad at the input shaft ≈ 39 000 motor counts ≈ 5600 ticks.
+    assert!(e.tick > 5_000 && e.tick < 6_500, "{}", e.tick);
+}
+
+#[test]
+fn missed_tick_latches_overrun() {
+    let mut m = Monitor::new(Config::default()).unwrap();
+    at_rest(&mut m, 0, 0, 200);
+    let late = Inputs {
+        ticks_elapsed: 3,
+        ..Inputs::new(MID, 0, 0, false)
+    };
+    let e = m.step(&late);
+    assert!(e.flags.overrun);
+    assert!(!e.flags.sensor_fault);
+    assert_eq!(e.tick, 203);
+    let e = at_rest(&mut m, 0, 0, 100);
+    assert!(e.flags.overrun);
+    m.reset_flags();
+    assert!(!m.flags().any());
+    // ticks_elapsed = 0 counts as an on-time tick.
+    let e = m.step(&Inputs {
+        ticks_elapsed: 0,
+        ..Inputs::new(MID, 0, 0, false)
+    });
+    assert!(!e.flags.overrun);
+    assert_eq!(e.tick, 304);
+}
+
+#[test]
+fn very_late_step_reseats_the_observer_and_is_untrusted() {
+    let mut m = Monitor::new(Config::default()).unwrap();
+    at_rest(&mut m, 100, 0, 200);
+    let e = m.step(&Inputs {
+        ticks_elapsed: 200,
+        ..Inputs::new(MID, 0, 150, false)
+    });
+    assert!(e.flags.overrun);
+    assert!(!e.flags.sensor_fault, "50 counts in 200 ticks is plausible");
+    assert!(!e.trusted);
+}
+
+#[test]
+fn missed_ticks_while_moving_keep_tracking() {
+    // 4 output counts per tick (15.3 rad/s), every fourth call covers two ticks.
+    let mut m = Monitor::new(Config::default()).unwrap();
+    let (mut out, mut motor) = (0_u32, 0_u32);
+    let mut e = m.step(&Inputs::new(MID, motor, out, true));
+    for k in 0..4000_u32 {
+        let n = if k % 4 == 3 { 2 } else { 1 };
+        out = (out + 4 * n) & 0x3FFF;
+        motor = (motor + 30 * n) & 0xFFFF;
+        e = m.step(&Inputs {
+            ticks_elapsed: n as u8,
+            ..Inputs::new(MID, motor, out, true)
+        });
+    }
+    assert!(e.flags.overrun && !e.flags.sensor_fault, "{:?}", e.flags);
+    let want = 4.0 * core::f64::consts::TAU / 16_384.0 * 10_000.0;
+    let got = e.output_speed_rad_s.to_num::<f64>();
+    assert!((got - want).abs() < 0.02 * want, "{got} vs {want}");
+}
+
+#[test]
+fn estimate_words_round_trip_the_fields() {
+    let mut m = Monitor::new(Config::default()).unwrap();
+    let e = at_rest(&mut m, 77, 0, 300);
+    let w = e.to_words();
+    assert_eq!(w.len(), ESTIMATE_WORDS);
+    assert_eq!(w[0], 300);
+    assert_eq!(w[1] as i32, e.pressing_force_n.to_bits());
+    assert_eq!(w[12] & 0xFF, BrakeState::Locked as u32);
+    assert_eq!((w[12] >> 8) & 0xFF, Scene::Holding as u32);
+    assert_eq!(w[12] >> 24, u32::from(e.flags.bits()));
+    // The checksum covers the body: a changed field changes it.
+    let mut other = e;
+    other.tick += 1;
+    assert_ne!(other.to_words()[13], w[13]);
+}
+
+fn err(config: Config) -> ConfigError {
+    Monitor::new(config).unwrap_err()
+}
+
+#[test]
+fn constructor_rejects_non_finite_parameters() {
+    let mut c = Config::default();
+    c.mechanism.socket_radius_m = f64::NAN;
+    assert_eq!(
+        err(c),
+        ConfigError::NotFinite {
+            parameter: "mechanism.socket_radius_m"
+        }
+    );
+    let mut c = Config::default();
+    c.thresholds.creep_limit_rad = f64::INFINITY;
+    assert_eq!(
+        err(c),
+        ConfigError::NotFinite {
+            parameter: "thresholds.creep_limit_rad"
+        }
+    );
+}
+
+#[test]
+fn constructor_rejects_out_of_range_parameters() {
+    let mut c = Config::default();
+    c.mechanism.output_inertia_kg_m2 = -0.15;
+    assert_eq!(
+        err(c),
+        ConfigError::OutOfRange {
+            parameter: "mechanism.output_inertia_kg_m2"
+        }
+    );
+    let mut c = Config::default();
+    c.sensors.reducer_efficiency = 1.2;
+    assert_eq!(
+        err(c),
+        ConfigError::OutOfRange {
+            parameter: "sensors.reducer_efficiency"
+        }
+    );
+    let mut c = Config::default();
+    c.thresholds.breakaway_speed_rad_s = 0.1;
+    assert_eq!(
+        err(c),
+        ConfigError::OutOfRange {
+            parameter: "thresholds.breakaway_speed_rad_s"
+        }
+    );
+    let mut c = Config::default();
+    c.sensors.output_encoder_bits = 30;
+    assert_eq!(
+        err(c),
+        ConfigError::OutOfRange {
+            parameter: "sensors.output_encoder_bits"
+        }
+    );
+}
+
+#[test]
+fn constructor_rejects_formats_that_would_overflow() {
+    // A 0.2 mm socket radius makes the ramp force of 60 N·m 300 kN: beyond Q16.
+    let mut c = Config::default();
+    c.mechanism.socket_radius_m = 0.0002;
+    assert_eq!(
+        err(c),
+        ConfigError::Overflow {
+            parameter: "mechanism.socket_radius_m"
+        }
+    );
+    // A 100 kA current sensor: drive torque beyond Q16.
+    let mut c = Config::default();
+    c.sensors.current_full_scale_a = 100_000.0;
+    assert_eq!(
+        err(c),
+        ConfigError::Overflow {
+            parameter: "sensors.current_full_scale_a"
+        }
+    );
+    // A 10-bit motor counter aliases at 1800 rad/s over 8 late ticks.
+    let mut c = Config::default();
+    c.sensors.motor_counter_bits = 10;
+    assert_eq!(
+        err(c),
+        ConfigError::Overflow {
+            parameter: "sensors.motor_counter_bits"
+        }
+    );
+}
+
+#[test]
+fn constructor_rejects_an_unstable_observer() {
+    let c = Config {
+        observer: ObserverGains {
+            angle: 2.5,
+            speed_per_s: 10.0,
+            accel_per_s2: 10.0,
+        },
+        ..Config::default()
+    };
+    assert_eq!(
+        err(c),
+        ConfigError::Unstable {
+            parameter: "observer"
+        }
+    );
+    // Stable at one tick, unstable when a late step advances it by six or more (Jury test on
+    // (I − LC)·A^n): rejected with the default catch-up of 8, accepted with 5.
+    let gains = ObserverGains {
+        angle: 0.05,
+        speed_per_s: 100.0,
+        accel_per_s2: 10_000.0,
+    };
+    assert!(gains.is_stable(1e-4) && gains.is_stable(5e-4) && !gains.is_stable(6e-4));
+    let mut c = Config {
+        observer: gains,
+        ..Config::default()
+    };
+    assert_eq!(
+        err(c),
+        ConfigError::Unstable {
+            parameter: "max_catchup_ticks"
+        }
+    );
+    c.max_catchup_ticks = 5;
+    assert!(Monitor::new(c).is_ok());
+    // A slower tick with the same gains: outside the stability region.
+    let c = Config {
+        tick_hz: 1_000.0,
+        ..Config::default()
+    };
+    assert_eq!(
+        err(c),
+        ConfigError::Unstable {
+            parameter: "observer"
+        }
+    );
+}
+
+#[test]
+fn constructor_rejects_gains_beyond_their_format() {
+    // A 300 Hz triple pole: l₂ (∝ bandwidth²) no longer fits its Scale<36> mantissa (nor l₃,
+    // ∝ bandwidth³, its Scale<33>; the first one checked is named).
+    let c = Config {
+        observer: ObserverGains::triple_pole(300.0, 10_000.0),
+        ..Config::default()
+    };
+    assert_eq!(
+        err(c),
+        ConfigError::Overflow {
+            parameter: "observer.speed_per_s"
+        }
+    );
+    // A 3 Hz one: l₂ would keep fewer than 20 significant bits in its Scale<36>.
+    let c = Config {
+        observer: ObserverGains::triple_pole(3.0, 10_000.0),
+        ..Config::default()
+    };
+    assert_eq!(
+        err(c),
+        ConfigError::OutOfRange {
+            parameter: "observer.speed_per_s"
+        }
+    );
+}
+
+#[test]
+fn errors_name_their_parameter_in_the_message() {
+    let e = ConfigError::Overflow {
+        parameter: "capacity_mu",
+    };
+    assert_eq!(e.parameter(), "capacity_mu");
+    assert_eq!(
+        e.to_string(),
+        "monitor configuration: capacity_mu overflows the fixed-point format"
+    );
+}

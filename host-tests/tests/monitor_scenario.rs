@@ -1,0 +1,490 @@
+//! Synthetic scenarios for the monitor: a small f64 plant (output shaft under a constant load,
+//! ideal speed-servo drive, quasi-static pack with Table 1 stick/slip) produces quantised
+//! encoder counts and ADC codes; the monitor's estimates are checked against the plant's truth.
+//!
+//! The plant is written here, independently of the monitor's code, from the same
+//! `noback::mechanism` and `noback::sensors` numbers (one source of truth for parameters).
+
+use noback::mechanism::{Mechanism, TABLE2};
+use noback::monitor::{BrakeState, Config, Estimate, Inputs, Monitor, Scene};
+use noback::sensors::{SensorConfig, DEFAULT_SENSORS};
+
+const TICK_HZ: f64 = 10_000.0;
+const H: f64 = 1.0 / TICK_HZ;
+const SUBSTEPS: u32 = 20;
+
+/// The f64 plant.
+struct Plant {
+    mech: Mechanism,
+    sensors: SensorConfig,
+    load_nm: f64,
+    /// Pack capacity factor (1 = nominal μ); a worn pack is < 1.
+    pack_factor: f64,
+    /// Extra pack torque while driving (N·m), a dragging pack.
+    extra_drag_nm: f64,
+    theta: f64,
+    omega: f64,
+    theta_in: f64,
+    drive_torque: f64,
+    adc_noise: u32,
+    rng: u32,
+    /// Output-encoder offset (counts) so that the trace crosses the 14-bit wrap.
+    out_offset: f64,
+    /// Friction energy dissipated in the pack (J).
+    energy: f64,
+}
+
+impl Plant {
+    fn new(load_nm: f64, omega: f64) -> Plant {
+        Plant {
+            mech: TABLE2,
+            sensors: DEFAULT_SENSORS,
+            load_nm,
+            pack_factor: 1.0,
+            extra_drag_nm: 0.0,
+            theta: 0.0,
+            omega,
+            theta_in: 0.0,
+            drive_torque: 0.0,
+            adc_noise: 2,
+            rng: 0x1234_5678,
+            out_offset: 16_300.0,
+            energy: 0.0,
+        }
+    }
+
+    fn per_newton(&self) -> f64 {
+        self.mech.pack_torque_per_newton_m(self.mech.mu_static) * self.pack_factor
+    }
+
+    fn spring_drag(&self) -> f64 {
+        self.per_newton() * self.mech.spring_preload_n()
+    }
+
+    /// Capacity with the ramps engaged (pressing force from the load, quasi-static).
+    fn engaged_capacity(&self) -> f64 {
+        self.per_newton() * self.mech.quasi_static_pressing_force_n(self.load_nm)
+    }
+
+    /// Advances one tick. `drive = Some(speed_ref)` runs the ideal speed servo.
+    fn tick(&mut self, drive: Option<f64>) {
+        let dt = H / f64::from(SUBSTEPS);
+        let j = self.mech.output_inertia_kg_m2;
+        let m = self.load_nm;
+        let mut u_sum = 0.0;
+        for _ in 0..SUBSTEPS {
+            match drive {
+                Some(w_ref) => {
+                    // Ideal servo: the speed follows the reference with at most 50 rad/s² (within the drive's 25 A).
+                    let dw = (w_ref - self.omega).clamp(-50.0 * dt, 50.0 * dt);
+                    let w_new = self.omega + dw;
+                    let s = if w_new > 0.0 {
+                        1.0
+                    } else if w_new < 0.0 {
+                        -1.0
+                    } else {
+                        0.0
+                    };
+                    let pack = s * (self.spring_drag() + self.extra_drag_nm);
+                    let u = if s == 0.0 { -m } else { j * dw / dt - m + pack };
+                    u_sum += u;
+                    self.energy += (pack * 0.5 * (self.omega + w_new)).abs() * dt;
+                    self.theta += 0.5 * (self.omega + w_new) * dt;
+                    self.theta_in += 0.5 * (self.omega + w_new) * dt;
+                    self.omega = w_new;
+                }
+                None => {
+                    let engaged = self.omega == 0.0 || self.omega.signum() == m.signum();
+                    let cap = if engaged {
+                        self.engaged_capacity()
+                    } else {
+                        self.spring_drag()
+                    };
+                    if self.omega == 0.0 {
+                        if m.abs() <= cap {
+                            continue; // stuck: the pack carries the load (Table 1)
+                        }
+                        let a = (m - m.signum() * cap) / j;
+                        self.omega = a * dt;
+                        self.theta += 0.5 * self.omega * dt;
+                        self.energy += cap * (0.5 * self.omega * dt).abs();
+                    } else {
+                        let a = (m - self.omega.signum() * cap) / j;
+                        let w_new = self.omega + a * dt;
+                        if w_new.signum() != self.omega.signum() {
+                            // Crossed zero inside the sub-step: stop there.
+                            let travel = 0.5 * self.omega * (self.omega / -a);
+                            self.theta += travel;
+                            self.energy += cap * travel.abs();
+                            self.omega = 0.0;
+                        } else {
+                            let travel = 0.5 * (self.omega + w_new) * dt;
+                            self.theta += travel;
+                            self.energy += cap * travel.abs();
+                            self.omega = w_new;
+                        }
+                    }
+                }
+            }
+        }
+        self.drive_torque = u_sum / f64::from(SUBSTEPS);
+    }
+
+    fn next_noise(&mut self) -> i32 {
+        let mut x = self.rng;
+        x ^= x << 13;
+        x ^= x >> 17;
+        x ^= x << 5;
+        self.rng = x;
+        let span = 2 * self.adc_noise + 1;
+        (x % span) as i32 - self.adc_noise as i32
+    }
+
+    fn inputs(&mut self, drive: bool) -> Inputs {
+        let s = self.sensors;
+        let u = if drive { self.drive_torque } else { 0.0 };
+        let motoring = u * self.omega >= 0.0;
+        let k = s.motor_torque_constant_nm_a * s.reducer_ratio;
+        let current = if motoring {
+            u / (k * s.reducer_efficiency)
+        } else {
+            u * s.reducer_efficiency / k
+        };
+        let noise = self.next_noise();
+        let code = (2048.0 + (current / s.amps_per_count()).round()) as i32 + noise;
+        let out = (self.theta / s.output_rad_per_count() + self.out_offset).floor() as i64;
+        let motor = (self.theta_in / s.input_rad_per_motor_count()).floor() as i64;
+        Inputs::new(
+            code.clamp(0, 4095) as u16,
+            motor.rem_euclid(1 << 16) as u32,
+            out.rem_euclid(1 << 14) as u32,
+            drive,
+        )
+    }
+}
+
+/// Runs `plant` for `seconds`, the drive on at `speed` until `cut_s`, and returns the trace.
+fn run(
+    plant: &mut Plant,
+    monitor: &mut Monitor,
+    speed: f64,
+    cut_s: f64,
+    seconds: f64,
+) -> Vec<(f64, f64, Estimate)> {
+    let ticks = (seconds * TICK_HZ).round() as u32;
+    let mut trace = Vec::new();
+    for k in 0..ticks {
+        let t = f64::from(k) * H;
+        let drive = t < cut_s;
+        plant.tick(if drive { Some(speed) } else { None });
+        let inputs = plant.inputs(drive);
+        let e = monitor.step(&inputs);
+        trace.push((t + H, plant.omega, e));
+    }
+    trace
+}
+
+fn first_time(
+    trace: &[(f64, f64, Estimate)],
+    pred: impl Fn(&(f64, f64, Estimate)) -> bool,
+) -> Option<f64> {
+    trace.iter().find(|x| pred(x)).map(|x| x.0)
+}
+
+/// Time at which the plant's output stopped for good.
+fn true_lock_time(trace: &[(f64, f64, Estimate)], after: f64) -> Option<f64> {
+    let last_moving = trace.iter().rev().find(|x| x.1 != 0.0)?;
+    (last_moving.0 > after).then_some(last_moving.0)
+}
+
+fn dump(trace: &[(f64, f64, Estimate)], name: &str) {
+    if std::env::var("MONITOR_DUMP").is_ok_and(|v| v == name) {
+        for (t, w, e) in trace.iter().step_by(20) {
+            println!(
+                "{t:.4} w={w:8.3} scene={:?} brake={:?} w^={:8.3} load={:8.3} T={:8.3} Tm={:8.3} u={:8.3} h={:.3} trusted={} flags={:?}",
+                e.scene, e.brake, e.output_speed_rad_s.to_num::<f64>(), e.load_torque_nm.to_num::<f64>(),
+                e.braking_torque_nm.to_num::<f64>(), e.measured_braking_torque_nm.to_num::<f64>(),
+                e.drive_torque_nm.to_num::<f64>(), e.pack_health.to_num::<f64>(), e.trusted, e.flags.bits()
+            );
+        }
+    }
+}
+
+fn check_paper_case(load: f64, speed: f64, name: &str) {
+    let mut plant = Plant::new(load, speed);
+    let mut monitor = Monitor::new(Config::default()).unwrap();
+    let trace = run(&mut plant, &mut monitor, speed, 0.2, 0.7);
+    let last = trace.last().unwrap().2;
+    dump(&trace, name);
+    let spring = TABLE2.spring_preload_n();
+    let want_force = TABLE2.quasi_static_pressing_force_n(load);
+    let hold = last.braking_torque_nm.to_num::<f64>();
+    let force = last.pressing_force_n.to_num::<f64>();
+    let lock_true = true_lock_time(&trace, 0.2).unwrap();
+    let lock_seen = first_time(&trace, |x| x.0 > 0.2 && x.2.brake == BrakeState::Locked).unwrap();
+    let load_at_cut = trace
+        .iter()
+        .find(|x| x.0 >= 0.2)
+        .unwrap()
+        .2
+        .load_torque_nm
+        .to_num::<f64>();
+    println!(
+        "{name}: holding {hold:.3} N·m (load {load}), force {force:.1} N (want {want_force:.1} = {spring:.1} + {:.1}), \
+         load at cut {load_at_cut:.3}, lock true {lock_true:.4} s seen {lock_seen:.4} s, margin {:.3}, energy {:.3} J, health {:.4}",
+        want_force - spring,
+        last.capacity_margin.to_num::<f64>(),
+        last.friction_energy_j.to_num::<f64>(),
+        last.pack_health.to_num::<f64>(),
+    );
+    // Heat: the monitor integrates |T·ω| of its own Table 1 torque and observed speed; the plant
+    // integrates the true pack torque over the true travel.
+    let energy = last.friction_energy_j.to_num::<f64>();
+    println!(
+        "{name}: friction energy {energy:.3} J, plant {:.3} J",
+        plant.energy
+    );
+    assert!(
+        (energy - plant.energy).abs() <= 0.05 * plant.energy,
+        "energy {energy} vs {}",
+        plant.energy
+    );
+    assert!(
+        (hold - load).abs() <= 0.05 * load.abs(),
+        "holding torque {hold} vs {load}"
+    );
+    assert!(
+        (force - want_force).abs() <= 0.10 * want_force,
+        "force {force} vs {want_force}"
+    );
+    assert_eq!(last.brake, BrakeState::Locked);
+    assert_eq!(last.scene, Scene::Holding);
+    assert!(last.trusted);
+    assert!(!last.flags.any(), "false alarm: {:?}", last.flags);
+    // Lock seen after the plant locked, within the dwell plus 10 ms.
+    assert!(
+        lock_seen >= lock_true && lock_seen - lock_true <= 0.02,
+        "{lock_seen} vs {lock_true}"
+    );
+    // While driving (settled) the pack is released at spring pressure.
+    let driving = trace.iter().find(|x| x.0 > 0.15).unwrap().2;
+    assert_eq!(driving.scene, Scene::Driving);
+    assert_eq!(driving.brake, BrakeState::Released);
+    assert!((driving.pressing_force_n.to_num::<f64>() - spring).abs() < 0.01);
+}
+
+#[test]
+fn forward_load_released_at_0_2_s_brakes_to_lock() {
+    // Closing along the load: the drive holds the output back at 13.78 rad/s (back-driven).
+    check_paper_case(20.3, 13.78, "forward");
+}
+
+#[test]
+fn reverse_load_released_at_0_2_s_brakes_to_lock() {
+    // Opening against the load: the drive lifts at 13.78 rad/s, the output coasts, reverses, locks.
+    check_paper_case(20.3, -13.78, "reverse");
+}
+
+#[test]
+fn negative_load_mirrors() {
+    check_paper_case(-12.0, -8.0, "negative forward");
+}
+
+#[test]
+fn worn_pack_raises_brake_weak_within_50_ms_of_the_cut() {
+    let mut plant = Plant::new(20.3, 13.78);
+    plant.pack_factor = 0.5;
+    let mut monitor = Monitor::new(Config::default()).unwrap();
+    let trace = run(&mut plant, &mut monitor, 13.78, 0.2, 0.8);
+    dump(&trace, "worn");
+    let weak = first_time(&trace, |x| x.2.flags.brake_weak).unwrap();
+    let last = trace.last().unwrap().2;
+    println!(
+        "worn pack: brake_weak at {weak:.4} s, health {:.3}, margin {:.3}",
+        last.pack_health.to_num::<f64>(),
+        last.capacity_margin.to_num::<f64>()
+    );
+    assert!(weak > 0.2 && weak - 0.2 <= 0.05, "{weak}");
+    assert!(!last.flags.brake_slip && !last.flags.brake_drag && !last.flags.sensor_fault);
+    assert!(last.capacity_margin.to_num::<f64>() < 1.5);
+}
+
+#[test]
+fn pack_losing_grip_while_holding_raises_brake_slip() {
+    let mut plant = Plant::new(20.3, 13.78);
+    let mut monitor = Monitor::new(Config::default()).unwrap();
+    let mut trace = run(&mut plant, &mut monitor, 13.78, 0.2, 0.5);
+    assert!(!trace.last().unwrap().2.flags.any());
+    // The spring breaks and μ drops: capacity 0.3 × nominal < load.
+    plant.pack_factor = 0.3;
+    for k in 0..3000 {
+        plant.tick(None);
+        let e = monitor.step(&plant.inputs(false));
+        trace.push((0.5 + f64::from(k + 1) * H, plant.omega, e));
+    }
+    let slip = first_time(&trace, |x| x.2.flags.brake_slip).unwrap();
+    let moved = first_time(&trace, |x| x.0 > 0.5 && x.1 != 0.0).unwrap();
+    println!("slip: output moving at {moved:.4} s, brake_slip at {slip:.4} s");
+    assert!(slip > moved && slip - moved <= 0.1, "{slip} vs {moved}");
+}
+
+#[test]
+fn dragging_pack_while_driving_raises_brake_drag() {
+    // Drive, stop and hold (load learned), then drive again with a pack dragging 12 N·m more than nominal.
+    let mut plant = Plant::new(-10.0, 5.0);
+    let mut monitor = Monitor::new(Config::default()).unwrap();
+    let mut trace = run(&mut plant, &mut monitor, 5.0, 0.3, 0.6);
+    assert!(
+        !trace.last().unwrap().2.flags.any(),
+        "{:?}",
+        trace.last().unwrap().2.flags
+    );
+    plant.extra_drag_nm = 12.0;
+    let restart = trace.last().unwrap().0;
+    for k in 0..4000 {
+        plant.tick(Some(5.0));
+        let e = monitor.step(&plant.inputs(true));
+        trace.push((restart + f64::from(k + 1) * H, plant.omega, e));
+    }
+    let drag = first_time(&trace, |x| x.2.flags.brake_drag).unwrap();
+    let last = trace.last().unwrap().2;
+    println!("drag: restart {restart:.4} s, brake_drag at {drag:.4} s");
+    assert!(drag > restart && drag - restart <= 0.2, "{drag}");
+    assert!(
+        !last.flags.brake_slip && !last.flags.sensor_fault,
+        "{:?}",
+        last.flags
+    );
+}
+
+#[test]
+fn nominal_restart_raises_nothing() {
+    let mut plant = Plant::new(-10.0, 5.0);
+    let mut monitor = Monitor::new(Config::default()).unwrap();
+    let mut trace = run(&mut plant, &mut monitor, 5.0, 0.3, 0.6);
+    let restart = trace.last().unwrap().0;
+    for k in 0..6000 {
+        let drive = k < 4000;
+        plant.tick(drive.then_some(-5.0));
+        let e = monitor.step(&plant.inputs(drive));
+        trace.push((restart + f64::from(k + 1) * H, plant.omega, e));
+    }
+    dump(&trace, "restart");
+    let last = trace.last().unwrap().2;
+    assert!(!last.flags.any(), "{:?}", last.flags);
+    assert_eq!(last.brake, BrakeState::Locked);
+    let hold = last.braking_torque_nm.to_num::<f64>();
+    assert!((hold + 10.0).abs() <= 0.5, "{hold}");
+}
+
+mod envelope {
+    //! Property tests over the operating envelope: the fixed-point step against f64 shadows.
+
+    use super::*;
+    use proptest::prelude::*;
+
+    /// Shadow of the estimate's derived fields, recomputed in f64 from its own load estimate.
+    fn check_shadow(e: &Estimate) -> Result<(), TestCaseError> {
+        let m = TABLE2;
+        let load = e.load_torque_nm.to_num::<f64>();
+        let engaged = e.brake != BrakeState::Released;
+        let force = if engaged {
+            m.quasi_static_pressing_force_n(load)
+        } else {
+            m.spring_preload_n()
+        };
+        let got = e.pressing_force_n.to_num::<f64>();
+        prop_assert!(
+            (got - force).abs() <= 1e-3 * force,
+            "force {} vs {}",
+            got,
+            force
+        );
+        if load.abs() >= 1.0 {
+            let cap = m.pack_capacity_nm(m.quasi_static_pressing_force_n(load), m.mu_static);
+            let margin = e.pack_health.to_num::<f64>() * cap / load.abs();
+            let got = e.capacity_margin.to_num::<f64>();
+            prop_assert!(
+                (got - margin.min(1000.0)).abs() <= 1e-3 * margin + 1e-4,
+                "margin {} vs {}",
+                got,
+                margin
+            );
+        }
+        if e.brake == BrakeState::Locked {
+            let got = e.braking_torque_nm.to_num::<f64>();
+            prop_assert!((got - load).abs() <= 1e-4, "holding {} vs {}", got, load);
+        }
+        Ok(())
+    }
+
+    proptest! {
+        #![proptest_config(ProptestConfig { cases: 48, ..ProptestConfig::default() })]
+
+        /// The Monte Carlo range of issue 4 (load 5–30 N·m either way, 5–20 rad/s either way,
+        /// here widened to 2 N·m and 2 rad/s): released at 0.3 s, the output locks and the
+        /// monitor holds the load within 5 %, with no flag.
+        #[test]
+        fn release_to_lock_across_the_drive_envelope(
+            load in 2.0_f64..30.0, load_neg in any::<bool>(),
+            speed in 2.0_f64..20.0, speed_neg in any::<bool>(),
+            offset in 0.0_f64..16_384.0,
+        ) {
+            let load = if load_neg { -load } else { load };
+            let speed = if speed_neg { -speed } else { speed };
+            let mut plant = Plant::new(load, speed);
+            plant.out_offset = offset;
+            let mut monitor = Monitor::new(Config::default()).unwrap();
+            let trace = run(&mut plant, &mut monitor, speed, 0.3, 1.0);
+            for (t, w, e) in &trace {
+                check_shadow(e)?;
+                if *t > 0.15 {
+                    let got = e.output_speed_rad_s.to_num::<f64>();
+                    prop_assert!((got - w).abs() <= 0.5 + 0.05 * w.abs(), "t {} speed {} vs {}", t, got, w);
+                }
+            }
+            let last = trace.last().unwrap().2;
+            prop_assert_eq!(last.brake, BrakeState::Locked);
+            prop_assert!(!last.flags.any(), "{:?}", last.flags);
+            prop_assert!(last.trusted);
+            let hold = last.braking_torque_nm.to_num::<f64>();
+            prop_assert!((hold - load).abs() <= 0.05 * load.abs(), "hold {} vs {}", hold, load);
+        }
+
+        /// Power-on with the drive off anywhere in the envelope (load ±60 N·m, ±50 rad/s): no
+        /// overflow — the speed tracks the plant, the derived fields match their f64 shadows —
+        /// no sensor fault, and a lock once the plant has stopped.
+        #[test]
+        fn power_on_braking_across_the_full_envelope(
+            load in -60.0_f64..60.0,
+            speed in -50.0_f64..50.0,
+            offset in 0.0_f64..16_384.0,
+        ) {
+            let mut plant = Plant::new(load, speed);
+            plant.out_offset = offset;
+            let mut monitor = Monitor::new(Config::default()).unwrap();
+            let trace = run(&mut plant, &mut monitor, 0.0, 0.0, 1.5);
+            // The observer needs its settling time after power-on and after the plant stops
+            // abruptly (up to 440 rad/s² to rest in one tick, unknown load): 0.1 s and 50 ms are
+            // left out of the speed comparison.
+            let mut stopped_at = f64::NEG_INFINITY;
+            let mut prev_w = speed;
+            for (t, w, e) in &trace {
+                check_shadow(e)?;
+                if *w == 0.0 && prev_w != 0.0 {
+                    stopped_at = *t;
+                }
+                prev_w = *w;
+                if *t > 0.1 && *t - stopped_at > 0.05 {
+                    let got = e.output_speed_rad_s.to_num::<f64>();
+                    prop_assert!((got - w).abs() <= 1.0 + 0.05 * w.abs(), "t {} speed {} vs {}", t, got, w);
+                }
+                prop_assert!(!e.flags.sensor_fault && !e.flags.overrun, "t {} {:?}", t, e.flags);
+            }
+            let last = trace.last().unwrap();
+            if last.1 == 0.0 && trace.iter().rev().nth(500).is_some_and(|x| x.1 == 0.0) {
+                prop_assert_eq!(last.2.brake, BrakeState::Locked);
+            }
+        }
+    }
+}

@@ -1,0 +1,16 @@
+//! Build script: `memory.x` and cortex-m-rt's `link.x` on the thumb link line (no defmt here).
+
+use std::env;
+use std::fs;
+use std::path::PathBuf;
+
+fn main() -> Result<(), String> {
+    println!("cargo:rerun-if-changed=../memory.x");
+    if env::var("TARGET").is_ok_and(|t| t.starts_with("thumb")) {
+        let out = PathBuf::from(env::var_os("OUT_DIR").ok_or("OUT_DIR is not set")?);
+        fs::copy("../memory.x", out.join("memory.x")).map_err(|e| format!("memory.x: {e}"))?;
+        println!("cargo:rustc-link-search={}", out.display());
+        println!("cargo:rustc-link-arg=-Tlink.x");
+    }
+    Ok(())
+}

@@ -1,0 +1,748 @@
+//! Configuration (SI, `f64`, checked once) and its conversion into the fixed-point constants the
+//! step uses ([`Params`]). Every division and unit conversion of the monitor happens here.
+
+use super::scale::{Scale, ScaleError};
+use crate::fx::{Gain, Q16};
+use crate::mechanism::{Mechanism, TABLE2};
+use crate::sensors::{SensorConfig, DEFAULT_SENSORS};
+
+/// Observer gains of the current-estimator form (see [`crate::monitor`]): the angle, speed and
+/// acceleration corrections per unit of angle innovation.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ObserverGains {
+    /// l₁, angle correction (dimensionless).
+    pub angle: f64,
+    /// l₂, speed correction (1/s).
+    pub speed_per_s: f64,
+    /// l₃, acceleration correction (1/s²); the torque correction is `J_s·l₃`.
+    pub accel_per_s2: f64,
+}
+
+impl ObserverGains {
+    /// Gains that put the three error poles at `p = exp(−2π·bandwidth_hz/tick_hz)`:
+    /// `l₁ = 1 − p³`, `l₂ = 3(1 − p)²(1 + p)/(2h)`, `l₃ = (1 − p)³/h²`.
+    pub fn triple_pole(bandwidth_hz: f64, tick_hz: f64) -> ObserverGains {
+        let h = 1.0 / tick_hz;
+        let p = exp_neg(core::f64::consts::TAU * bandwidth_hz * h);
+        let q = 1.0 - p;
+        ObserverGains {
+            angle: 1.0 - p * p * p,
+            speed_per_s: 3.0 * q * q * (1.0 + p) / (2.0 * h),
+            accel_per_s2: q * q * q / (h * h),
+        }
+    }
+
+    /// Coefficients `[a2, a1, a0]` of the error dynamics' characteristic polynomial
+    /// `z³ + a2·z² + a1·z + a0` for a step of `h` seconds.
+    pub fn characteristic(&self, h: f64) -> [f64; 3] {
+        let (l1, l2, l3) = (self.angle, self.speed_per_s, self.accel_per_s2);
+        [
+            h * h * l3 / 2.0 + h * l2 + l1 - 3.0,
+            h * h * l3 / 2.0 - h * l2 - 2.0 * l1 + 3.0,
+            l1 - 1.0,
+        ]
+    }
+
+    /// Jury test: all roots of the characteristic polynomial strictly inside the unit circle.
+    pub fn is_stable(&self, h: f64) -> bool {
+        let [a2, a1, a0] = self.characteristic(h);
+        let p1 = 1.0 + a2 + a1 + a0;
+        let pm1 = -1.0 + a2 - a1 + a0;
+        let abs = |x: f64| if x < 0.0 { -x } else { x };
+        p1 > 0.0 && pm1 < 0.0 && abs(a0) < 1.0 && abs(a0 * a0 - 1.0) > abs(a0 * a2 - a1)
+    }
+}
+
+/// `e^-x` for `x ≥ 0` (configuration time only): halve until ≤ 1/64, Taylor, square back.
+fn exp_neg(x: f64) -> f64 {
+    if x.is_nan() {
+        return f64::NAN;
+    }
+    if x < 0.0 || !x.is_finite() {
+        return 0.0;
+    }
+    let mut y = x;
+    let mut halvings = 0;
+    while y > 1.0 / 64.0 && halvings < 64 {
+        y *= 0.5;
+        halvings += 1;
+    }
+    let mut term = 1.0;
+    let mut sum = 1.0;
+    let mut k = 1.0;
+    while k < 12.0 {
+        term *= -y / k;
+        sum += term;
+        k += 1.0;
+    }
+    while halvings > 0 {
+        sum *= sum;
+        halvings -= 1;
+    }
+    sum
+}
+
+/// Limits and time constants (SI). Defaults in [`Thresholds::DEFAULT`], with their reasons in
+/// docs/monitor-design.md.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Thresholds {
+    /// Operating envelope of the load (N·m); an implied load beyond it while driving means the
+    /// current is above the model (`brake_drag`).
+    pub max_load_nm: f64,
+    /// Karnopp band and lock detection: |ω_out| below this is "stuck" (rad/s).
+    pub stick_speed_rad_s: f64,
+    /// A locked output breaks loose above this speed (rad/s); > stick speed (hysteresis).
+    pub breakaway_speed_rad_s: f64,
+    /// Time |ω_out| must stay in the stick band before the pack counts as locked (s).
+    pub lock_dwell_s: f64,
+    /// Output travel allowed after the brake locked with the drive off (rad): `brake_slip`.
+    pub creep_limit_rad: f64,
+    /// Braking envelope, time: how long the output may keep moving (drive off) after the
+    /// nominal model, started from the speed at the cut, has stopped it (s): `brake_weak`.
+    pub braking_grace_s: f64,
+    /// Braking envelope, angle: the output angle during braking may exceed the nominal model's
+    /// by this factor …
+    pub braking_angle_factor: f64,
+    /// … plus this allowance (rad), before `brake_weak`.
+    pub braking_angle_allowance_rad: f64,
+    /// Lowest capacity margin (capacity over |load|) before `brake_weak`.
+    pub min_capacity_margin: f64,
+    /// Loads below this (N·m) are too small for a margin or a load direction.
+    pub min_load_nm: f64,
+    /// Pack torque above the nominal spring drag allowed while driving (N·m): `brake_drag`.
+    pub drag_allowance_nm: f64,
+    /// A brake condition must persist this long before its flag latches (s).
+    pub flag_persistence_s: f64,
+    /// Observer settling time after power-on or re-initialisation (s); untrusted meanwhile.
+    pub settle_time_s: f64,
+    /// Time after the ramps engage before the pack health is learned (ramp backlash) (s).
+    pub engage_settle_s: f64,
+    /// Bandwidth of the load-estimate filter (Hz).
+    pub load_filter_hz: f64,
+    /// Bandwidth of the input-speed filter (Hz).
+    pub input_speed_filter_hz: f64,
+    /// Output faster than input by this much (rad/s), drive on: overrunning.
+    pub overrun_speed_band_rad_s: f64,
+    /// Fastest plausible output speed (rad/s): larger encoder steps are a sensor fault.
+    pub max_output_speed_rad_s: f64,
+    /// Fastest plausible motor speed (rad/s, motor side).
+    pub max_motor_speed_rad_s: f64,
+    /// Travel of one shaft while the other's counter stands still, driving, before the still
+    /// counter counts as stuck (rad, output side).
+    pub max_lost_motion_rad: f64,
+    /// Largest plausible |current| with the drive off (A).
+    pub current_off_max_a: f64,
+    /// Time at an ADC rail before the current reading counts as failed (s).
+    pub adc_rail_time_s: f64,
+    /// Rate at which the pack-health estimate may move (1/s, sign-LMS step).
+    pub health_rate_per_s: f64,
+}
+
+impl Thresholds {
+    /// Defaults for Table 2 and the default sensors.
+    pub const DEFAULT: Thresholds = Thresholds {
+        max_load_nm: 60.0,
+        stick_speed_rad_s: 0.3,
+        breakaway_speed_rad_s: 1.0,
+        lock_dwell_s: 0.01,
+        creep_limit_rad: 0.02,
+        braking_grace_s: 0.4,
+        braking_angle_factor: 2.0,
+        braking_angle_allowance_rad: 1.0,
+        min_capacity_margin: 1.5,
+        min_load_nm: 1.0,
+        drag_allowance_nm: 8.0,
+        flag_persistence_s: 0.01,
+        settle_time_s: 0.1,
+        engage_settle_s: 0.02,
+        load_filter_hz: 10.0,
+        input_speed_filter_hz: 200.0,
+        overrun_speed_band_rad_s: 0.5,
+        max_output_speed_rad_s: 60.0,
+        max_motor_speed_rad_s: 1800.0,
+        max_lost_motion_rad: 2.0,
+        current_off_max_a: 3.0,
+        adc_rail_time_s: 0.002,
+        health_rate_per_s: 25.0,
+    };
+}
+
+impl Default for Thresholds {
+    fn default() -> Self {
+        Thresholds::DEFAULT
+    }
+}
+
+/// Everything the monitor is configured with; separate from its state.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Config {
+    /// The mechanism (Table 2 by default).
+    pub mechanism: Mechanism,
+    /// Motor, reducer and sensors.
+    pub sensors: SensorConfig,
+    /// Flag limits and time constants.
+    pub thresholds: Thresholds,
+    /// Output-shaft observer gains.
+    pub observer: ObserverGains,
+    /// Step rate (Hz); the step is `h = 1/tick_hz`.
+    pub tick_hz: f64,
+    /// Friction coefficient in the pack capacity `T_all`; default μ_s (the paper's levels, see
+    /// MODEL.md).
+    pub capacity_mu: f64,
+    /// Factor from motor torque × ratio to output torque when the load back-drives the motor
+    /// (power flowing to the motor); default `1/η`. When motoring, `η` is used.
+    pub backdrive_efficiency: f64,
+    /// Most ticks one late step may cover (1..=32); the observer must be stable when advanced
+    /// by any of 1..=this many ticks with one correction.
+    pub max_catchup_ticks: u8,
+}
+
+/// Default observer bandwidth (Hz).
+pub const DEFAULT_OBSERVER_BANDWIDTH_HZ: f64 = 30.0;
+/// Default tick rate (Hz).
+pub const DEFAULT_TICK_HZ: f64 = 10_000.0;
+
+impl Config {
+    /// Defaults around a mechanism and sensors: 10 kHz, 20 Hz observer, μ_s in `T_all`.
+    pub fn new(mechanism: Mechanism, sensors: SensorConfig) -> Config {
+        Config {
+            mechanism,
+            sensors,
+            thresholds: Thresholds::DEFAULT,
+            observer: ObserverGains::triple_pole(DEFAULT_OBSERVER_BANDWIDTH_HZ, DEFAULT_TICK_HZ),
+            tick_hz: DEFAULT_TICK_HZ,
+            capacity_mu: mechanism.mu_static,
+            backdrive_efficiency: 1.0 / sensors.reducer_efficiency,
+            max_catchup_ticks: 8,
+        }
+    }
+}
+
+impl Default for Config {
+    fn default() -> Self {
+        Config::new(TABLE2, DEFAULT_SENSORS)
+    }
+}
+
+/// Why a configuration was rejected; each names the offending parameter.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum ConfigError {
+    /// NaN or infinite.
+    NotFinite {
+        /// The parameter's path, e.g. `"mechanism.output_inertia_kg_m2"`.
+        parameter: &'static str,
+    },
+    /// Outside its physical or supported range (zero inertia, efficiency > 1, …).
+    OutOfRange {
+        /// The parameter's path.
+        parameter: &'static str,
+    },
+    /// A derived constant or an envelope value would not fit its fixed-point format.
+    Overflow {
+        /// The parameter's path.
+        parameter: &'static str,
+    },
+    /// The observer's error dynamics are not stable for some step count 1..=max_catchup_ticks.
+    Unstable {
+        /// The parameter's path.
+        parameter: &'static str,
+    },
+}
+
+impl ConfigError {
+    /// The parameter the error names.
+    pub const fn parameter(&self) -> &'static str {
+        match self {
+            ConfigError::NotFinite { parameter }
+            | ConfigError::OutOfRange { parameter }
+            | ConfigError::Overflow { parameter }
+            | ConfigError::Unstable { parameter } => parameter,
+        }
+    }
+}
+
+impl core::fmt::Display for ConfigError {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        let what = match self {
+            ConfigError::NotFinite { .. } => "is not finite",
+            ConfigError::OutOfRange { .. } => "is out of range",
+            ConfigError::Overflow { .. } => "overflows the fixed-point format",
+            ConfigError::Unstable { .. } => "makes the observer unstable",
+        };
+        write!(f, "monitor configuration: {} {}", self.parameter(), what)
+    }
+}
+
+/// The fixed-point constants of the step, all derived in [`Params::from_config`].
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) struct Params {
+    // Sensors.
+    pub adc_bits: u8,
+    pub adc_max_code: u16,
+    pub adc_rail_ticks: u32,
+    pub current_off_counts: i32,
+    pub out_bits: u8,
+    pub out_mask: u32,
+    pub out_shift: u32,
+    pub out_jump_counts: i32,
+    pub motor_bits: u8,
+    pub motor_mask: u32,
+    pub motor_jump_counts: i32,
+    pub lost_motor_counts: u32,
+    pub lost_out_counts: u32,
+    // Drive: ADC counts → output-side N·m (Q16 bits).
+    pub drive_motoring: Scale<16>,
+    pub drive_backdriven: Scale<16>,
+    pub input_speed: Scale<11>,
+    pub input_alpha: Gain,
+    // Observer (see observer.rs for the units).
+    pub obs: super::observer::ObserverScales,
+    pub max_catchup: u8,
+    // Pack.
+    pub spring_force: Q16,
+    pub spring_drag: Q16,
+    pub ramp_factor: Scale<21>,
+    pub capacity_per_n: Scale<32>,
+    pub inv_engaged_kappa: Scale<27>,
+    // Thresholds.
+    pub max_load: Q16,
+    pub min_load: Q16,
+    pub stick_speed: Q16,
+    pub breakaway_speed: Q16,
+    pub overrun_band: Q16,
+    pub drag_allowance: Q16,
+    pub min_margin: Scale<26>,
+    pub lock_dwell_ticks: u32,
+    pub persistence_ticks: u32,
+    pub settle_ticks: u32,
+    pub engage_settle_ticks: u32,
+    pub braking_grace_ticks: u32,
+    pub creep_counts: i32,
+    pub braking_angle_factor: Scale<25>,
+    pub braking_angle_allowance: i32,
+    pub speed_to_counts: Scale<28>,
+    pub innovation_limit: i32,
+    pub load_alpha: Gain,
+    pub load_known_ticks: u32,
+    pub health_step: i32,
+    pub energy_per_tick: Scale<32>,
+}
+
+/// Largest value (in its unit) any Q16 quantity of the envelope may reach: half the format's
+/// range, so that sums of two envelope values cannot saturate.
+const Q16_ENVELOPE: f64 = 16_384.0;
+
+fn finite(x: f64, parameter: &'static str) -> Result<f64, ConfigError> {
+    if x.is_finite() {
+        Ok(x)
+    } else {
+        Err(ConfigError::NotFinite { parameter })
+    }
+}
+
+fn positive(x: f64, parameter: &'static str) -> Result<f64, ConfigError> {
+    if finite(x, parameter)? > 0.0 {
+        Ok(x)
+    } else {
+        Err(ConfigError::OutOfRange { parameter })
+    }
+}
+
+/// A constant in its [`Scale`] format; the error names the parameter it derives from.
+fn scale<const S: u32>(k: f64, parameter: &'static str) -> Result<Scale<S>, ConfigError> {
+    Scale::from_f64(k).map_err(|e| match e {
+        ScaleError::NotFinite => ConfigError::NotFinite { parameter },
+        ScaleError::TooLarge => ConfigError::Overflow { parameter },
+        ScaleError::TooFine => ConfigError::OutOfRange { parameter },
+    })
+}
+
+fn q16(x: f64, parameter: &'static str) -> Result<Q16, ConfigError> {
+    let x = finite(x, parameter)?;
+    if !(-Q16_ENVELOPE..=Q16_ENVELOPE).contains(&x) {
+        return Err(ConfigError::Overflow { parameter });
+    }
+    // In range (checked above); `checked_` so that no panic path (NaN) is compiled in.
+    Q16::checked_from_num(x).ok_or(ConfigError::Overflow { parameter })
+}
+
+fn gain(alpha: f64, parameter: &'static str) -> Result<Gain, ConfigError> {
+    if alpha > 0.0 && alpha < 1.0 {
+        Gain::checked_from_num(alpha).ok_or(ConfigError::OutOfRange { parameter })
+    } else {
+        Err(ConfigError::OutOfRange { parameter })
+    }
+}
+
+/// Seconds to ticks, at least 1, at most 2^31.
+fn ticks(seconds: f64, tick_hz: f64, parameter: &'static str) -> Result<u32, ConfigError> {
+    let t = positive(seconds, parameter)? * tick_hz;
+    if t > 2_147_483_648.0 {
+        return Err(ConfigError::Overflow { parameter });
+    }
+    Ok(((t + 0.5) as u32).max(1))
+}
+
+/// A count limit (≥ 1) that must fit an i32 with room to spare.
+fn counts(x: f64, parameter: &'static str) -> Result<i32, ConfigError> {
+    let x = positive(x, parameter)?;
+    if x > 1.0e9 {
+        return Err(ConfigError::Overflow { parameter });
+    }
+    Ok(((x + 0.5) as i32).max(1))
+}
+
+impl Params {
+    pub(crate) fn from_config(c: &Config) -> Result<Params, ConfigError> {
+        let m = &c.mechanism;
+        let s = &c.sensors;
+        let t = &c.thresholds;
+        let tick_hz = positive(c.tick_hz, "tick_hz")?;
+        if !(100.0..=1.0e6).contains(&tick_hz) {
+            return Err(ConfigError::OutOfRange {
+                parameter: "tick_hz",
+            });
+        }
+        let h = 1.0 / tick_hz;
+
+        // --- Mechanism.
+        let j = positive(m.output_inertia_kg_m2, "mechanism.output_inertia_kg_m2")?;
+        positive(m.socket_radius_m, "mechanism.socket_radius_m")?;
+        let chamfer = positive(m.socket_chamfer_rad, "mechanism.socket_chamfer_rad")?;
+        if chamfer >= core::f64::consts::FRAC_PI_2 {
+            return Err(ConfigError::OutOfRange {
+                parameter: "mechanism.socket_chamfer_rad",
+            });
+        }
+        let r1 = positive(m.pack_inner_radius_m, "mechanism.pack_inner_radius_m")?;
+        let r2 = positive(m.pack_outer_radius_m, "mechanism.pack_outer_radius_m")?;
+        if r2 <= r1 {
+            return Err(ConfigError::OutOfRange {
+                parameter: "mechanism.pack_outer_radius_m",
+            });
+        }
+        if m.friction_discs == 0 {
+            return Err(ConfigError::OutOfRange {
+                parameter: "mechanism.friction_discs",
+            });
+        }
+        let groove = finite(m.groove_angle_rad, "mechanism.groove_angle_rad")?;
+        if !(0.0..core::f64::consts::TAU).contains(&groove) {
+            return Err(ConfigError::OutOfRange {
+                parameter: "mechanism.groove_angle_rad",
+            });
+        }
+        finite(m.spring_stiffness_n_m, "mechanism.spring_stiffness_n_m")?;
+        finite(m.spring_preload_m, "mechanism.spring_preload_m")?;
+        finite(m.pack_clearance_m, "mechanism.pack_clearance_m")?;
+        if m.spring_stiffness_n_m < 0.0 {
+            return Err(ConfigError::OutOfRange {
+                parameter: "mechanism.spring_stiffness_n_m",
+            });
+        }
+        let mu = finite(c.capacity_mu, "capacity_mu")?;
+        if !(0.0..=2.0).contains(&mu) || mu == 0.0 {
+            return Err(ConfigError::OutOfRange {
+                parameter: "capacity_mu",
+            });
+        }
+        let ramp = m.ramp_factor_per_m(); // N per N·m
+        let per_n = m.pack_torque_per_newton_m(mu); // N·m per N
+        let spring = m.spring_preload_n();
+        let max_load = positive(t.max_load_nm, "thresholds.max_load_nm")?;
+        let max_force = spring + ramp * max_load;
+        if !(0.0..=Q16_ENVELOPE).contains(&max_force) {
+            return Err(ConfigError::Overflow {
+                parameter: "mechanism.socket_radius_m",
+            });
+        }
+        if !(0.0..=Q16_ENVELOPE).contains(&(per_n * max_force)) {
+            return Err(ConfigError::Overflow {
+                parameter: "capacity_mu",
+            });
+        }
+        let kappa = 1.0 - per_n * ramp;
+        // κ ≈ 0 would make the engaged load inversion ill-conditioned.
+        if kappa > -0.05 && kappa < 0.05 {
+            return Err(ConfigError::OutOfRange {
+                parameter: "mechanism.socket_chamfer_rad",
+            });
+        }
+
+        // --- Sensors.
+        let kt = positive(
+            s.motor_torque_constant_nm_a,
+            "sensors.motor_torque_constant_nm_a",
+        )?;
+        let ratio = positive(s.reducer_ratio, "sensors.reducer_ratio")?;
+        let eff = positive(s.reducer_efficiency, "sensors.reducer_efficiency")?;
+        if eff > 1.0 {
+            return Err(ConfigError::OutOfRange {
+                parameter: "sensors.reducer_efficiency",
+            });
+        }
+        let back = positive(c.backdrive_efficiency, "backdrive_efficiency")?;
+        if !(4..=16).contains(&s.current_adc_bits) {
+            return Err(ConfigError::OutOfRange {
+                parameter: "sensors.current_adc_bits",
+            });
+        }
+        let full_scale = positive(s.current_full_scale_a, "sensors.current_full_scale_a")?;
+        if !(8..=24).contains(&s.output_encoder_bits) {
+            return Err(ConfigError::OutOfRange {
+                parameter: "sensors.output_encoder_bits",
+            });
+        }
+        if !(8..=32).contains(&s.motor_counter_bits) {
+            return Err(ConfigError::OutOfRange {
+                parameter: "sensors.motor_counter_bits",
+            });
+        }
+        if s.motor_encoder_counts_per_rev == 0 {
+            return Err(ConfigError::OutOfRange {
+                parameter: "sensors.motor_encoder_counts_per_rev",
+            });
+        }
+        let amps = s.amps_per_count();
+        let max_drive = full_scale * kt * ratio * eff.max(back);
+        if max_drive > Q16_ENVELOPE {
+            return Err(ConfigError::Overflow {
+                parameter: "sensors.current_full_scale_a",
+            });
+        }
+        let out_rad = s.output_rad_per_count();
+        let in_rad = s.input_rad_per_motor_count(); // input-shaft rad per motor count
+        if !(1..=32).contains(&c.max_catchup_ticks) {
+            return Err(ConfigError::OutOfRange {
+                parameter: "max_catchup_ticks",
+            });
+        }
+        let catchup = f64::from(c.max_catchup_ticks);
+        let max_out_speed = positive(
+            t.max_output_speed_rad_s,
+            "thresholds.max_output_speed_rad_s",
+        )?;
+        let max_motor_speed =
+            positive(t.max_motor_speed_rad_s, "thresholds.max_motor_speed_rad_s")?;
+        if max_out_speed > Q16_ENVELOPE || max_motor_speed / ratio > Q16_ENVELOPE {
+            return Err(ConfigError::Overflow {
+                parameter: "thresholds.max_output_speed_rad_s",
+            });
+        }
+        // Per-tick step limits; a late step may cover `catchup` ticks and must still be shorter
+        // than half a counter period, or `counter_delta` would alias.
+        let out_jump = max_out_speed * h / out_rad + 1.0;
+        let motor_jump = max_motor_speed * h / (in_rad * ratio) + 1.0;
+        let out_half = f64::from(1_u32 << (s.output_encoder_bits - 1));
+        let motor_half = f64::from(1_u32 << (s.motor_counter_bits - 1).min(30));
+        if out_jump * catchup >= out_half {
+            return Err(ConfigError::Overflow {
+                parameter: "sensors.output_encoder_bits",
+            });
+        }
+        if motor_jump * catchup >= motor_half {
+            return Err(ConfigError::Overflow {
+                parameter: "sensors.motor_counter_bits",
+            });
+        }
+
+        // --- Observer: stability for every step count it may be advanced by.
+        let g = c.observer;
+        finite(g.angle, "observer.angle")?;
+        finite(g.speed_per_s, "observer.speed_per_s")?;
+        finite(g.accel_per_s2, "observer.accel_per_s2")?;
+        let mut k = 1;
+        while k <= c.max_catchup_ticks {
+            if !g.is_stable(h * f64::from(k)) {
+                return Err(ConfigError::Unstable {
+                    parameter: if k == 1 {
+                        "observer"
+                    } else {
+                        "max_catchup_ticks"
+                    },
+                });
+            }
+            k += 1;
+        }
+        const Q16_ONE: f64 = 65_536.0;
+        let words_per_rad = 4_294_967_296.0 / core::f64::consts::TAU;
+        let obs = super::observer::ObserverScales {
+            // θ [word] += ω [Q16 bits] · h · words/rad / 2^16
+            theta_v: scale(h * words_per_rad / Q16_ONE, "tick_hz")?,
+            // θ += a·h²/2 with a = τ/J: τ [Q16 bits] → words
+            theta_a: scale(
+                h * h / (2.0 * j) * words_per_rad / Q16_ONE,
+                "mechanism.output_inertia_kg_m2",
+            )?,
+            // ω [Q16] += τ [Q16] · h/J
+            v_a: scale(h / j, "mechanism.output_inertia_kg_m2")?,
+            l_theta: scale(g.angle, "observer.angle")?,
+            l_v: scale(
+                g.speed_per_s / words_per_rad * Q16_ONE,
+                "observer.speed_per_s",
+            )?,
+            l_d: scale(
+                j * g.accel_per_s2 / words_per_rad * Q16_ONE,
+                "observer.accel_per_s2",
+            )?,
+        };
+
+        // --- Thresholds.
+        let stick = positive(t.stick_speed_rad_s, "thresholds.stick_speed_rad_s")?;
+        let breakaway = positive(t.breakaway_speed_rad_s, "thresholds.breakaway_speed_rad_s")?;
+        if breakaway <= stick {
+            return Err(ConfigError::OutOfRange {
+                parameter: "thresholds.breakaway_speed_rad_s",
+            });
+        }
+        let min_margin = positive(t.min_capacity_margin, "thresholds.min_capacity_margin")?;
+        let alpha = |hz: f64, parameter| -> Result<Gain, ConfigError> {
+            let hz = positive(hz, parameter)?;
+            gain(1.0 - exp_neg(core::f64::consts::TAU * hz * h), parameter)
+        };
+        let current_off = positive(t.current_off_max_a, "thresholds.current_off_max_a")? / amps;
+        let lost = positive(t.max_lost_motion_rad, "thresholds.max_lost_motion_rad")?;
+        let energy = h * 256.0; // Q16 W → U40F24 J per tick: P·2^-16·h·2^24
+        let health_step = positive(t.health_rate_per_s, "thresholds.health_rate_per_s")? * h;
+        if health_step >= 0.5 {
+            return Err(ConfigError::OutOfRange {
+                parameter: "thresholds.health_rate_per_s",
+            });
+        }
+        Ok(Params {
+            adc_bits: s.current_adc_bits,
+            adc_max_code: ((1_u32 << s.current_adc_bits) - 1) as u16,
+            adc_rail_ticks: ticks(t.adc_rail_time_s, tick_hz, "thresholds.adc_rail_time_s")?,
+            current_off_counts: counts(current_off, "thresholds.current_off_max_a")?,
+            out_bits: s.output_encoder_bits,
+            out_mask: (1_u32 << s.output_encoder_bits) - 1,
+            out_shift: 32 - u32::from(s.output_encoder_bits),
+            out_jump_counts: counts(out_jump, "thresholds.max_output_speed_rad_s")?,
+            motor_bits: s.motor_counter_bits,
+            motor_mask: u32::MAX >> (32 - u32::from(s.motor_counter_bits)),
+            motor_jump_counts: counts(motor_jump, "thresholds.max_motor_speed_rad_s")?,
+            lost_motor_counts: counts(lost / in_rad, "thresholds.max_lost_motion_rad")? as u32,
+            lost_out_counts: counts(lost / out_rad, "thresholds.max_lost_motion_rad")? as u32,
+            drive_motoring: scale(
+                amps * kt * ratio * eff * Q16_ONE,
+                "sensors.reducer_efficiency",
+            )?,
+            drive_backdriven: scale(amps * kt * ratio * back * Q16_ONE, "backdrive_efficiency")?,
+            input_speed: scale(in_rad / h * Q16_ONE, "sensors.motor_encoder_counts_per_rev")?,
+            input_alpha: alpha(t.input_speed_filter_hz, "thresholds.input_speed_filter_hz")?,
+            obs,
+            max_catchup: c.max_catchup_ticks,
+            spring_force: q16(spring, "mechanism.spring_preload_m")?,
+            spring_drag: q16(per_n * spring, "mechanism.spring_preload_m")?,
+            ramp_factor: scale(ramp, "mechanism.socket_radius_m")?,
+            capacity_per_n: scale(per_n, "capacity_mu")?,
+            inv_engaged_kappa: scale(1.0 / kappa, "mechanism.socket_chamfer_rad")?,
+            max_load: q16(max_load, "thresholds.max_load_nm")?,
+            min_load: q16(
+                positive(t.min_load_nm, "thresholds.min_load_nm")?,
+                "thresholds.min_load_nm",
+            )?,
+            stick_speed: q16(stick, "thresholds.stick_speed_rad_s")?,
+            breakaway_speed: q16(breakaway, "thresholds.breakaway_speed_rad_s")?,
+            overrun_band: q16(
+                positive(
+                    t.overrun_speed_band_rad_s,
+                    "thresholds.overrun_speed_band_rad_s",
+                )?,
+                "thresholds.overrun_speed_band_rad_s",
+            )?,
+            drag_allowance: q16(
+                positive(t.drag_allowance_nm, "thresholds.drag_allowance_nm")?,
+                "thresholds.drag_allowance_nm",
+            )?,
+            min_margin: scale(min_margin, "thresholds.min_capacity_margin")?,
+            lock_dwell_ticks: ticks(t.lock_dwell_s, tick_hz, "thresholds.lock_dwell_s")?,
+            persistence_ticks: ticks(
+                t.flag_persistence_s,
+                tick_hz,
+                "thresholds.flag_persistence_s",
+            )?,
+            settle_ticks: ticks(t.settle_time_s, tick_hz, "thresholds.settle_time_s")?,
+            engage_settle_ticks: ticks(t.engage_settle_s, tick_hz, "thresholds.engage_settle_s")?,
+            braking_grace_ticks: ticks(t.braking_grace_s, tick_hz, "thresholds.braking_grace_s")?,
+            creep_counts: counts(
+                positive(t.creep_limit_rad, "thresholds.creep_limit_rad")? / out_rad,
+                "thresholds.creep_limit_rad",
+            )?,
+            braking_angle_factor: scale(
+                positive(t.braking_angle_factor, "thresholds.braking_angle_factor")?,
+                "thresholds.braking_angle_factor",
+            )?,
+            // Q16 output counts.
+            braking_angle_allowance: counts(
+                positive(
+                    t.braking_angle_allowance_rad,
+                    "thresholds.braking_angle_allowance_rad",
+                )? / out_rad
+                    * Q16_ONE,
+                "thresholds.braking_angle_allowance_rad",
+            )?,
+            // Q16 rad/s → Q16 output counts per tick.
+            speed_to_counts: scale(h / out_rad, "sensors.output_encoder_bits")?,
+            innovation_limit: counts(out_jump, "thresholds.max_output_speed_rad_s")?
+                .saturating_mul(1_i32 << (32 - u32::from(s.output_encoder_bits)).min(30)),
+            load_alpha: alpha(t.load_filter_hz, "thresholds.load_filter_hz")?,
+            // Three time constants of the load filter (95 %).
+            load_known_ticks: ticks(
+                3.0 / (core::f64::consts::TAU
+                    * positive(t.load_filter_hz, "thresholds.load_filter_hz")?),
+                tick_hz,
+                "thresholds.load_filter_hz",
+            )?,
+            health_step: ((health_step * Q16_ONE + 0.5) as i32).max(1),
+            energy_per_tick: scale(energy, "tick_hz")?,
+        })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    extern crate std;
+    use super::*;
+
+    #[test]
+    fn triple_pole_gains_are_stable_and_match_the_poles() {
+        let g = ObserverGains::triple_pole(20.0, 10_000.0);
+        assert!(g.is_stable(1e-4));
+        // The characteristic polynomial is (z − p)³.
+        let p = (-core::f64::consts::TAU * 20.0 * 1e-4).exp();
+        let [a2, a1, a0] = g.characteristic(1e-4);
+        assert!((a2 + 3.0 * p).abs() < 1e-12);
+        assert!((a1 - 3.0 * p * p).abs() < 1e-12);
+        assert!((a0 + p * p * p).abs() < 1e-12);
+    }
+
+    #[test]
+    fn jury_rejects_unstable_gains() {
+        let g = ObserverGains {
+            angle: 1.5,
+            speed_per_s: 0.0,
+            accel_per_s2: 0.0,
+        };
+        assert!(!g.is_stable(1e-4));
+        let fast = ObserverGains::triple_pole(3_000.0, 10_000.0);
+        // Stable at the design step, unstable when advanced by many ticks at once.
+        assert!(fast.is_stable(1e-4));
+        assert!(!fast.is_stable(8e-4));
+    }
+
+    #[test]
+    fn exp_neg_is_exact_enough() {
+        for x in [0.0, 1e-6, 0.0125, 0.5, 1.0, 3.0, 20.0] {
+            assert!(
+                (exp_neg(x) - (-x).exp()).abs() < 1e-13 * 1.0_f64.max((-x).exp()),
+                "{x}"
+            );
+        }
+    }
+
+    #[test]
+    fn defaults_convert() {
+        assert!(Params::from_config(&Config::default()).is_ok());
+    }
+}

@@ -1,0 +1,204 @@
+//! What goes into one monitor step ([`Inputs`]) and what comes out ([`Estimate`], [`Flags`],
+//! [`Scene`], [`BrakeState`]).
+//!
+//! Every output field is an integer, a `bool` or a `fixed` number, so estimates can be streamed
+//! and compared bit for bit ([`Estimate::to_words`]).
+
+use crate::fx::Q16;
+use fixed::types::U40F24;
+
+/// The raw readings of one tick.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Inputs {
+    /// Phase-current ADC code, offset binary (mid-scale = 0 A). Codes above the converter's
+    /// full scale are impossible and raise `sensor_fault`.
+    pub current_adc_code: u16,
+    /// Motor-encoder counter register; wraps modulo 2^`motor_counter_bits` (bits above are
+    /// ignored for the position but raise `sensor_fault`).
+    pub motor_counter: u32,
+    /// Output-shaft absolute encoder reading (`output_encoder_bits` wide, wraps once per turn).
+    pub output_counter: u32,
+    /// Whether the drive is commanded on.
+    pub drive_commanded: bool,
+    /// Ticks since the previous call: 1 when on time; `n > 1` means `n − 1` ticks were missed
+    /// (raises `overrun`; the model is advanced by `n` ticks). 0 is treated as 1.
+    pub ticks_elapsed: u8,
+}
+
+impl Inputs {
+    /// On-time inputs (`ticks_elapsed = 1`).
+    pub const fn new(
+        current_adc_code: u16,
+        motor_counter: u32,
+        output_counter: u32,
+        drive_commanded: bool,
+    ) -> Inputs {
+        Inputs {
+            current_adc_code,
+            motor_counter,
+            output_counter,
+            drive_commanded,
+            ticks_elapsed: 1,
+        }
+    }
+}
+
+/// The situation the monitor recognised; it selects the model used in the step.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[repr(u8)]
+pub enum Scene {
+    /// Drive on and the input leads: pack released to its spring drag, load learned.
+    Driving = 0,
+    /// Drive off and the output locked: the pack holds the load (Table 1, stuck row).
+    Holding = 1,
+    /// Drive off and the output moving: the brake must stop it (motor failure, power-on).
+    FaultBraking = 2,
+    /// Drive on but the output runs ahead of the input (load-aided closing): ramps engaged,
+    /// pack slipping at capacity.
+    Overrunning = 3,
+}
+
+/// State of the friction pack.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[repr(u8)]
+pub enum BrakeState {
+    /// Ramps not carrying load: pressing force is the spring preload only (drag).
+    Released = 0,
+    /// Ramps engaged and the pack slipping: braking torque = capacity (Table 1).
+    Slipping = 1,
+    /// Output stuck: braking torque = load, up to capacity (Table 1).
+    Locked = 2,
+}
+
+/// Failure flags. In [`Estimate::flags`] they are latched: once raised they stay until
+/// `Monitor::reset_flags`.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct Flags {
+    /// The output moved beyond the creep limit with the drive off after the brake had locked.
+    pub brake_slip: bool,
+    /// Capacity margin below the limit, or braking time/angle beyond the envelope.
+    pub brake_weak: bool,
+    /// Pack torque while driving beyond the allowance, or drive current above the model.
+    pub brake_drag: bool,
+    /// Implausible encoder or current reading (jump, stuck counter, out-of-range code).
+    pub sensor_fault: bool,
+    /// A tick was missed.
+    pub overrun: bool,
+}
+
+impl Flags {
+    /// Packs the flags: bit 0 brake_slip, 1 brake_weak, 2 brake_drag, 3 sensor_fault, 4 overrun.
+    ///
+    /// ```
+    /// use noback::monitor::Flags;
+    /// let f = Flags { brake_weak: true, overrun: true, ..Flags::default() };
+    /// assert_eq!(f.bits(), 0b1_0010);
+    /// assert_eq!(Flags::from_bits(f.bits()), f);
+    /// ```
+    pub const fn bits(self) -> u8 {
+        (self.brake_slip as u8)
+            | (self.brake_weak as u8) << 1
+            | (self.brake_drag as u8) << 2
+            | (self.sensor_fault as u8) << 3
+            | (self.overrun as u8) << 4
+    }
+
+    /// Inverse of [`Flags::bits`]; bits 5–7 are ignored.
+    pub const fn from_bits(bits: u8) -> Flags {
+        Flags {
+            brake_slip: bits & 1 != 0,
+            brake_weak: bits & 2 != 0,
+            brake_drag: bits & 4 != 0,
+            sensor_fault: bits & 8 != 0,
+            overrun: bits & 16 != 0,
+        }
+    }
+
+    /// Whether any flag is raised.
+    pub const fn any(self) -> bool {
+        self.bits() != 0
+    }
+
+    /// Flags raised in `self` or `other`.
+    pub const fn union(self, other: Flags) -> Flags {
+        Flags::from_bits(self.bits() | other.bits())
+    }
+}
+
+/// Number of words in [`Estimate::to_words`].
+pub const ESTIMATE_WORDS: usize = 14;
+
+/// The monitor's output for one tick. Signs follow the output shaft: positive = the direction
+/// in which a positive load torque turns it.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Estimate {
+    /// Tick counter (wraps after 2^32 ticks, 5 days at 10 kHz).
+    pub tick: u32,
+    /// Recognised scene.
+    pub scene: Scene,
+    /// Pack state.
+    pub brake: BrakeState,
+    /// Pressing force on the pack (N): spring preload, plus |load|·tanθ/r when the ramps hold
+    /// load.
+    pub pressing_force_n: Q16,
+    /// Braking torque of the pack by Table 1 (N·m, signed, opposing the output's motion).
+    pub braking_torque_nm: Q16,
+    /// Braking torque measured by the observer: load estimate − net torque (N·m).
+    pub measured_braking_torque_nm: Q16,
+    /// Load torque estimate on the output shaft (N·m); held while it cannot be observed.
+    pub load_torque_nm: Q16,
+    /// Drive torque at the no-back input from the motor current (N·m).
+    pub drive_torque_nm: Q16,
+    /// Output-shaft speed (rad/s), from the observer.
+    pub output_speed_rad_s: Q16,
+    /// Input-shaft speed (rad/s), motor encoder ÷ reducer ratio.
+    pub input_speed_rad_s: Q16,
+    /// Braking capacity (ramps engaged, scaled by the pack health) over |load|; saturates at
+    /// [`crate::monitor::MARGIN_MAX`] for loads below the minimum.
+    pub capacity_margin: Q16,
+    /// Pack health: measured over model braking torque while slipping (1.0 nominal).
+    pub pack_health: Q16,
+    /// Friction energy dissipated in the pack since power-on (J).
+    pub friction_energy_j: U40F24,
+    /// Whether the estimate can be relied on (load known, observer settled, sensors plausible).
+    pub trusted: bool,
+    /// Latched failure flags.
+    pub flags: Flags,
+}
+
+impl Estimate {
+    /// The estimate as words for streaming and digests: tick, force, braking torque, measured
+    /// braking torque, load, drive torque, output speed, input speed, margin, health (Q16 bits
+    /// as `u32`), energy low and high words, then `brake | scene << 8 | trusted << 16 |
+    /// flags << 24`, then an FNV-1a checksum of the first 13 words.
+    pub fn to_words(&self) -> [u32; ESTIMATE_WORDS] {
+        let energy = self.friction_energy_j.to_bits();
+        let packed = u32::from(self.brake as u8)
+            | u32::from(self.scene as u8) << 8
+            | u32::from(self.trusted) << 16
+            | u32::from(self.flags.bits()) << 24;
+        let body = [
+            self.tick,
+            self.pressing_force_n.to_bits() as u32,
+            self.braking_torque_nm.to_bits() as u32,
+            self.measured_braking_torque_nm.to_bits() as u32,
+            self.load_torque_nm.to_bits() as u32,
+            self.drive_torque_nm.to_bits() as u32,
+            self.output_speed_rad_s.to_bits() as u32,
+            self.input_speed_rad_s.to_bits() as u32,
+            self.capacity_margin.to_bits() as u32,
+            self.pack_health.to_bits() as u32,
+            energy as u32,
+            (energy >> 32) as u32,
+            packed,
+        ];
+        let mut hash = 0x811C_9DC5_u32;
+        for word in body {
+            for byte in word.to_le_bytes() {
+                hash = (hash ^ u32::from(byte)).wrapping_mul(0x0100_0193);
+            }
+        }
+        let [w0, w1, w2, w3, w4, w5, w6, w7, w8, w9, w10, w11, w12] = body;
+        [w0, w1, w2, w3, w4, w5, w6, w7, w8, w9, w10, w11, w12, hash]
+    }
+}

@@ -1,0 +1,215 @@
+//! Constant multipliers and the reciprocal: the only arithmetic the 10 kHz step needs besides
+//! additions.
+//!
+//! Every physical constant the step multiplies by (gains, unit conversions, `h/J_s`, …) is
+//! converted once, in `Monitor::new`, into a [`Scale<S>`]: a 32-bit mantissa with the binary
+//! point fixed **in the type**, `k = mul · 2^-S`. Each use site picks `S` so that the default
+//! constant's mantissa is about 2^26–2^28: every constant keeps ≥ 20 significant bits over a
+//! ×64 range below its default and ×8–×32 above it; outside that range `Monitor::new` rejects
+//! the configuration, naming the parameter. The product of an `i32` input with the mantissa
+//! fits an `i64` (|x·mul| < 2^62); it is rounded to nearest (ties up) and, when `S < 32`,
+//! **saturated** to `i32` (the inputs are physical quantities: a clipped value is the safe
+//! answer). With `S ≥ 32` the result is below 2^30 and cannot saturate, and the shift is the
+//! product's high word plus one 32-bit shift: about 6 instructions on Cortex-M3.
+//!
+//! [`recip_q16`] gives `1/x` in Q16 by Newton–Raphson on a normalised mantissa, so the step
+//! has no division (a software division costs ~100 instructions on Cortex-M0).
+
+/// Why a constant does not fit a [`Scale<S>`].
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum ScaleError {
+    /// NaN or infinite.
+    NotFinite,
+    /// `|k|·2^S ≥ 2^31`: the mantissa would overflow.
+    TooLarge,
+    /// `0 < |k|·2^S < 2^20`: fewer than 20 significant bits would be left.
+    TooFine,
+}
+
+/// A constant `k = mul · 2^-S`, applied to `i32` fixed-point bits. `S` is the number of
+/// fractional bits of the mantissa (1 ≤ S ≤ 62).
+///
+/// ```
+/// use noback::monitor::Scale;
+/// let k = Scale::<30>::from_f64(0.1).unwrap();
+/// assert_eq!(k.apply(1_000), 100);
+/// assert_eq!(k.apply(-15), -1);          // −1.5 rounds half up to −1
+/// let big = Scale::<8>::from_f64(1.0e6).unwrap();
+/// assert_eq!(big.apply(1 << 20), i32::MAX); // saturates
+/// assert!(Scale::<30>::from_f64(4.0).is_err()); // 4·2^30 does not fit 31 bits
+/// ```
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Scale<const S: u32> {
+    mul: i32,
+}
+
+/// 2^31 and 2^20 as f64.
+const MANTISSA_LIMIT: f64 = 2_147_483_648.0;
+const MANTISSA_FLOOR: f64 = 1_048_576.0;
+
+impl<const S: u32> Scale<S> {
+    /// Zero.
+    pub const ZERO: Self = Scale { mul: 0 };
+
+    /// Converts `k`; see [`ScaleError`] for the limits.
+    pub fn from_f64(k: f64) -> Result<Self, ScaleError> {
+        const { assert!(S >= 1 && S <= 62, "Scale<S>: 1 ≤ S ≤ 62") };
+        if !k.is_finite() {
+            return Err(ScaleError::NotFinite);
+        }
+        let mut scaled = if k < 0.0 { -k } else { k };
+        let mut s = 0;
+        while s < S {
+            scaled *= 2.0;
+            s += 1;
+        }
+        if scaled + 0.5 >= MANTISSA_LIMIT {
+            return Err(ScaleError::TooLarge);
+        }
+        if scaled != 0.0 && scaled < MANTISSA_FLOOR {
+            return Err(ScaleError::TooFine);
+        }
+        let mul = (scaled + 0.5) as i32; // `as` truncates; 0 ≤ scaled + 0.5 < 2^31
+        Ok(Scale {
+            mul: if k < 0.0 { -mul } else { mul },
+        })
+    }
+
+    /// `x · k`, rounded to nearest; saturated to `i32` when `S < 32` (it cannot overflow
+    /// otherwise).
+    #[inline]
+    pub fn apply(self, x: i32) -> i32 {
+        // |x·mul| < 2^31·2^31 = 2^62 and the rounding term ≤ 2^61: the sum fits an i64.
+        let wide = i64::from(x) * i64::from(self.mul) + (1_i64 << (S - 1));
+        if S >= 32 {
+            // |wide| < 2^62 + 2^61 → |wide >> S| < 2^31: exact conversion.
+            (wide >> S) as i32
+        } else {
+            sat_i32(wide >> S)
+        }
+    }
+
+    /// The value this scale represents (for tests and documentation; not used by the step).
+    pub fn to_f64(self) -> f64 {
+        let mut v = f64::from(self.mul);
+        let mut s = 0;
+        while s < S {
+            v *= 0.5;
+            s += 1;
+        }
+        v
+    }
+
+    /// The mantissa (`k = mul · 2^-S`).
+    pub const fn mantissa(self) -> i32 {
+        self.mul
+    }
+}
+
+/// Clamps an `i64` to `i32`: the saturation every fixed-point result goes through.
+#[inline]
+pub fn sat_i32(x: i64) -> i32 {
+    if x > i64::from(i32::MAX) {
+        i32::MAX
+    } else if x < i64::from(i32::MIN) {
+        i32::MIN
+    } else {
+        x as i32
+    }
+}
+
+/// `1/x` for a positive Q16 value given by its bits, as Q16 bits, **saturating** at `i32::MAX`
+/// (1/x ≥ 32 768, i.e. x ≤ 2^-15); `x ≤ 0` gives `i32::MAX` too (callers pass magnitudes).
+///
+/// Method: normalise `x = f·2^(32−n−16)` with `f ∈ [½, 1)` (count leading zeros), start from the
+/// minimax line `48/17 − 32/17·f` (error ≤ 1/17), and take three Newton steps
+/// `y ← y·(2 − f·y)` in Q30 (error squares each step: 1/17 → 3.5e-3 → 1.2e-5 → 1.5e-10).
+/// Error ≤ 1 LSB + 2^-27 relative (tested against f64).
+///
+/// ```
+/// use noback::monitor::recip_q16;
+/// let half = recip_q16(2 << 16);           // 1/2
+/// assert!((half - (1 << 15)).abs() <= 1);
+/// assert_eq!(recip_q16(1), i32::MAX);      // 1/2^-16 = 65 536 does not fit Q16
+/// ```
+pub fn recip_q16(x: i32) -> i32 {
+    if x <= 0 {
+        return i32::MAX;
+    }
+    let xu = x as u32; // x > 0
+    let n = xu.leading_zeros(); // 1..=31
+    let m = u64::from(xu << n); // f = m / 2^32 ∈ [½, 1)
+    const ONE_Q30: u64 = 1 << 30;
+    // y0 = 48/17 − 32/17·f in Q30 (constants folded at compile time: no run-time division).
+    const C48: u64 = (48 * ONE_Q30) / 17;
+    const C32: u64 = (32 * ONE_Q30) / 17;
+    let mut y = C48 - ((C32 * m) >> 32);
+    for _ in 0..3 {
+        let fy = (m * y) >> 32; // f·y in Q30, ≈ 2^30
+        let two_minus = (2 * ONE_Q30).saturating_sub(fy);
+        y = (y * two_minus) >> 30;
+    }
+    // 1/x_value = 2^16 · 2^32 / (x·2^16) … in Q16 bits: 2^32/x = 2^n / f = y·2^(n−30).
+    let wide = if n >= 30 {
+        y << (n - 30)
+    } else {
+        y >> (30 - n)
+    };
+    i32::try_from(wide).unwrap_or(i32::MAX)
+}
+
+#[cfg(test)]
+mod tests {
+    extern crate std;
+    use super::*;
+
+    #[test]
+    fn scale_keeps_20_bits_and_rejects_the_rest() {
+        for k in [1.0e-3, 3.7e-4, 0.25, 0.4999, -0.0498] {
+            let s = Scale::<32>::from_f64(k).unwrap_or(Scale::ZERO);
+            assert!((s.to_f64() - k).abs() <= 2f64.powi(-33), "{k}");
+        }
+        assert_eq!(Scale::<32>::from_f64(f64::NAN), Err(ScaleError::NotFinite));
+        assert_eq!(Scale::<32>::from_f64(0.5), Err(ScaleError::TooLarge));
+        assert_eq!(Scale::<32>::from_f64(1.0e-7), Err(ScaleError::TooFine));
+        assert_eq!(Scale::<32>::from_f64(0.0), Ok(Scale::ZERO));
+    }
+
+    #[test]
+    fn apply_rounds_to_nearest() {
+        let third = Scale::<32>::from_f64(1.0 / 3.0).unwrap_or(Scale::ZERO);
+        assert_eq!(third.apply(3), 1);
+        assert_eq!(third.apply(2), 1);
+        assert_eq!(third.apply(1), 0);
+        assert_eq!(third.apply(-2), -1);
+        // The stored 1/3 is (2^32 − 1)/3 · 2^-32, so −2^31·k = −715 827 882.5: ties round up.
+        assert_eq!(third.apply(i32::MIN), -715_827_882);
+        let big = Scale::<16>::from_f64(1000.0).unwrap_or(Scale::ZERO);
+        assert_eq!(big.apply(i32::MIN), i32::MIN);
+        assert_eq!(big.apply(-2_000), -2_000_000);
+    }
+
+    #[test]
+    fn recip_is_close() {
+        for bits in [
+            1_i32,
+            2,
+            3,
+            100,
+            65_535,
+            65_536,
+            65_537,
+            1 << 20,
+            1_330_000,
+            i32::MAX,
+        ] {
+            let exact = 65_536.0 * 65_536.0 / f64::from(bits);
+            let got = f64::from(recip_q16(bits));
+            let want = exact.min(f64::from(i32::MAX));
+            assert!(
+                (got - want).abs() <= 1.0 + want * 7.5e-9,
+                "{bits}: {got} vs {want}"
+            );
+        }
+    }
+}

@@ -1,0 +1,355 @@
+//! The sensor trace: what the MCU sees at 10 kHz next to the truth, in one documented CSV
+//! format (docs/trace-format.md) with a writer and a reader whose errors name the line and
+//! column. The monitor tests, the benchmarks and the firmware replay all read this format.
+//!
+//! ```text
+//! # noback-trace v1
+//! # sample_rate_hz=10000
+//! t_s,current_code,motor_count,output_count,drive_on,pressing_force_n,braking_torque_nm,output_speed_rad_s,input_speed_rad_s,output_angle_rad,brake_state
+//! 0.0000,2048,0,0,1,169.2,8.43,-13.78,-13.78,0,1
+//! ```
+
+use std::io::Write;
+
+/// The first line of every trace file.
+pub const HEADER: &str = "# noback-trace v1";
+
+/// The column names, in order.
+pub const COLUMNS: [&str; 11] = [
+    "t_s",
+    "current_code",
+    "motor_count",
+    "output_count",
+    "drive_on",
+    "pressing_force_n",
+    "braking_torque_nm",
+    "output_speed_rad_s",
+    "input_speed_rad_s",
+    "output_angle_rad",
+    "brake_state",
+];
+
+/// One row: the raw readings and the truth at one sample.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct TraceRow {
+    /// Time (s).
+    pub t_s: f64,
+    /// Motor phase-current ADC code (offset binary).
+    pub current_code: u16,
+    /// Motor-encoder counter value (wraps modulo 2^counter bits).
+    pub motor_count: u32,
+    /// Output absolute-encoder reading (wraps modulo 2^bits).
+    pub output_count: u32,
+    /// Drive commanded on.
+    pub drive_on: bool,
+    /// Truth: pack pressing force (N).
+    pub pressing_force_n: f64,
+    /// Truth: braking torque magnitude (N·m).
+    pub braking_torque_nm: f64,
+    /// Truth: output speed (rad/s, positive = load direction).
+    pub output_speed_rad_s: f64,
+    /// Truth: input speed (rad/s).
+    pub input_speed_rad_s: f64,
+    /// Truth: output angle (rad).
+    pub output_angle_rad: f64,
+    /// Truth: 0 released, 1 slipping, 2 locked.
+    pub brake_state: u8,
+}
+
+/// A whole trace.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Trace {
+    /// Sample rate (Hz).
+    pub sample_rate_hz: f64,
+    /// Rows in time order.
+    pub rows: Vec<TraceRow>,
+}
+
+/// Why a trace could not be read.
+#[derive(Debug)]
+pub enum TraceError {
+    /// The file could not be read or written.
+    Io(std::io::Error),
+    /// The content is malformed at `line` (1-based), `column` (1-based CSV field, 0 = line).
+    Parse {
+        /// Line number.
+        line: usize,
+        /// Field number.
+        column: usize,
+        /// What is wrong.
+        message: String,
+    },
+}
+
+impl std::fmt::Display for TraceError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            TraceError::Io(e) => write!(f, "trace i/o: {e}"),
+            TraceError::Parse {
+                line,
+                column,
+                message,
+            } => write!(f, "trace line {line}, column {column}: {message}"),
+        }
+    }
+}
+
+impl std::error::Error for TraceError {}
+
+impl From<std::io::Error> for TraceError {
+    fn from(e: std::io::Error) -> Self {
+        TraceError::Io(e)
+    }
+}
+
+fn parse_err(line: usize, column: usize, message: impl Into<String>) -> TraceError {
+    TraceError::Parse {
+        line,
+        column,
+        message: message.into(),
+    }
+}
+
+impl Trace {
+    /// Write the trace in the v1 CSV format.
+    pub fn write_to(&self, w: &mut dyn Write) -> Result<(), TraceError> {
+        writeln!(w, "{HEADER}")?;
+        writeln!(w, "# sample_rate_hz={}", self.sample_rate_hz)?;
+        writeln!(w, "{}", COLUMNS.join(","))?;
+        for r in &self.rows {
+            writeln!(
+                w,
+                "{:.4},{},{},{},{},{:.3},{:.4},{:.6},{:.6},{:.7},{}",
+                r.t_s,
+                r.current_code,
+                r.motor_count,
+                r.output_count,
+                u8::from(r.drive_on),
+                r.pressing_force_n,
+                r.braking_torque_nm,
+                r.output_speed_rad_s,
+                r.input_speed_rad_s,
+                r.output_angle_rad,
+                r.brake_state
+            )?;
+        }
+        Ok(())
+    }
+
+    /// Write to a file.
+    pub fn write(&self, path: &std::path::Path) -> Result<(), TraceError> {
+        let mut f = std::io::BufWriter::new(std::fs::File::create(path)?);
+        self.write_to(&mut f)?;
+        f.flush()?;
+        Ok(())
+    }
+
+    /// Read a trace file.
+    pub fn read(path: &std::path::Path) -> Result<Trace, TraceError> {
+        let text = std::fs::read_to_string(path)?;
+        Trace::parse(&text)
+    }
+
+    /// Parse the text of a trace.
+    pub fn parse(text: &str) -> Result<Trace, TraceError> {
+        let mut lines = text.lines().enumerate().map(|(i, l)| (i + 1, l));
+        match lines.next() {
+            Some((_, l)) if l.trim_end() == HEADER => {}
+            Some((n, l)) => {
+                return Err(parse_err(
+                    n,
+                    0,
+                    format!(
+                        "expected `{HEADER}`, found `{}`",
+                        l.chars().take(40).collect::<String>()
+                    ),
+                ))
+            }
+            None => return Err(parse_err(1, 0, "empty file")),
+        }
+        let mut trace = Trace {
+            sample_rate_hz: 0.0,
+            rows: Vec::new(),
+        };
+        let mut header_seen = false;
+        for (n, line) in lines {
+            let line = line.trim_end();
+            if line.is_empty() {
+                continue;
+            }
+            if let Some(meta) = line.strip_prefix('#') {
+                if let Some(v) = meta.trim().strip_prefix("sample_rate_hz=") {
+                    trace.sample_rate_hz = v
+                        .trim()
+                        .parse()
+                        .map_err(|_| parse_err(n, 0, format!("bad sample rate `{v}`")))?;
+                }
+                continue;
+            }
+            if !header_seen {
+                let cols: Vec<&str> = line.split(',').collect();
+                if cols != COLUMNS {
+                    let col = cols
+                        .iter()
+                        .zip(COLUMNS.iter())
+                        .position(|(a, b)| a != b)
+                        .unwrap_or(cols.len().min(COLUMNS.len()));
+                    return Err(parse_err(
+                        n,
+                        col + 1,
+                        format!("expected columns `{}`", COLUMNS.join(",")),
+                    ));
+                }
+                header_seen = true;
+                continue;
+            }
+            trace.rows.push(parse_row(n, line)?);
+        }
+        if !header_seen {
+            return Err(parse_err(1, 0, "no column header line"));
+        }
+        if trace.sample_rate_hz.is_nan() || trace.sample_rate_hz <= 0.0 {
+            return Err(parse_err(2, 0, "missing `# sample_rate_hz=` line"));
+        }
+        Ok(trace)
+    }
+}
+
+fn parse_row(n: usize, line: &str) -> Result<TraceRow, TraceError> {
+    let f: Vec<&str> = line.split(',').collect();
+    if f.len() != COLUMNS.len() {
+        return Err(parse_err(
+            n,
+            f.len().min(COLUMNS.len()) + 1,
+            format!("expected {} fields, found {}", COLUMNS.len(), f.len()),
+        ));
+    }
+    let field = |i: usize| f.get(i).copied().unwrap_or("").trim();
+    let float = |i: usize| -> Result<f64, TraceError> {
+        let v: f64 = field(i).parse().map_err(|_| {
+            parse_err(
+                n,
+                i + 1,
+                format!(
+                    "`{}` is not a number ({})",
+                    field(i),
+                    COLUMNS.get(i).unwrap_or(&"")
+                ),
+            )
+        })?;
+        if v.is_finite() {
+            Ok(v)
+        } else {
+            Err(parse_err(n, i + 1, "not finite"))
+        }
+    };
+    let int = |i: usize| -> Result<u32, TraceError> {
+        field(i).parse().map_err(|_| {
+            parse_err(
+                n,
+                i + 1,
+                format!(
+                    "`{}` is not an unsigned integer ({})",
+                    field(i),
+                    COLUMNS.get(i).unwrap_or(&"")
+                ),
+            )
+        })
+    };
+    let code = int(1)?;
+    let current_code =
+        u16::try_from(code).map_err(|_| parse_err(n, 2, "current code over 65535"))?;
+    let drive = int(4)?;
+    if drive > 1 {
+        return Err(parse_err(n, 5, "drive_on must be 0 or 1"));
+    }
+    let state = int(10)?;
+    if state > 2 {
+        return Err(parse_err(n, 11, "brake_state must be 0, 1 or 2"));
+    }
+    Ok(TraceRow {
+        t_s: float(0)?,
+        current_code,
+        motor_count: int(2)?,
+        output_count: int(3)?,
+        drive_on: drive == 1,
+        pressing_force_n: float(5)?,
+        braking_torque_nm: float(6)?,
+        output_speed_rad_s: float(7)?,
+        input_speed_rad_s: float(8)?,
+        output_angle_rad: float(9)?,
+        brake_state: state as u8,
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn sample() -> Trace {
+        Trace {
+            sample_rate_hz: 10_000.0,
+            rows: vec![
+                TraceRow {
+                    t_s: 0.0,
+                    current_code: 2048,
+                    motor_count: 65535,
+                    output_count: 16383,
+                    drive_on: true,
+                    pressing_force_n: 169.2,
+                    braking_torque_nm: 8.43,
+                    output_speed_rad_s: -13.78,
+                    input_speed_rad_s: -13.78,
+                    output_angle_rad: 0.0,
+                    brake_state: 1,
+                },
+                TraceRow {
+                    t_s: 0.0001,
+                    brake_state: 2,
+                    ..TraceRow::default()
+                },
+            ],
+        }
+    }
+
+    #[test]
+    fn round_trip() {
+        let t = sample();
+        let mut buf = Vec::new();
+        t.write_to(&mut buf).unwrap();
+        let text = String::from_utf8(buf).unwrap();
+        let back = Trace::parse(&text).unwrap();
+        assert_eq!(back.rows.len(), 2);
+        assert_eq!(back.rows[0].motor_count, 65535);
+        assert_eq!(back.rows[0].current_code, 2048);
+        assert!((back.rows[0].pressing_force_n - 169.2).abs() < 1e-9);
+        assert_eq!(back.sample_rate_hz, 10_000.0);
+    }
+
+    #[test]
+    fn errors_name_line_and_column() {
+        let t = sample();
+        let mut buf = Vec::new();
+        t.write_to(&mut buf).unwrap();
+        let text = String::from_utf8(buf).unwrap().replace("65535", "x");
+        match Trace::parse(&text) {
+            Err(TraceError::Parse { line, column, .. }) => assert_eq!((line, column), (4, 3)),
+            other => panic!("{other:?}"),
+        }
+        match Trace::parse("# noback-trace v0\n") {
+            Err(TraceError::Parse { line, column, .. }) => assert_eq!((line, column), (1, 0)),
+            other => panic!("{other:?}"),
+        }
+        let short = String::from_utf8({
+            let mut b = Vec::new();
+            t.write_to(&mut b).unwrap();
+            b
+        })
+        .unwrap()
+        .replace(",1\n0.0001", ",1,9\n0.0001");
+        match Trace::parse(&short) {
+            Err(TraceError::Parse { line, .. }) => assert_eq!(line, 4),
+            other => panic!("{other:?}"),
+        }
+    }
+}

@@ -1,0 +1,74 @@
+//! Faults change what they say: a pack that loses its friction lets the load run away; sensor
+//! faults change only the raw readings.
+
+use noback_twin::fault::{Fault, FaultKind};
+use noback_twin::metrics;
+use noback_twin::reading::Reading;
+use noback_twin::scene::{Scene, SceneKind};
+use noback_twin::sensing;
+use noback_twin::sim::{self, SAMPLE_RATE_HZ};
+
+#[test]
+fn friction_loss_lets_the_load_run_away() {
+    for reading in [Reading::Paper, Reading::Physical] {
+        let mut s = Scene::builtin(SceneKind::Hold, reading);
+        s.duration_s = 0.3;
+        s.faults.push(Fault {
+            kind: FaultKind::FrictionLoss,
+            at_s: 0.1,
+            severity: 0.8,
+        });
+        let r = sim::run(&s).unwrap();
+        let m = metrics::compute(&s, &r.samples, &r.stats, r.wall_s);
+        // Before the fault the brake holds; after it the output accelerates in the load direction.
+        let before = r.samples.iter().find(|x| x.t_s >= 0.09).unwrap();
+        assert!(
+            before.output_speed_rad_s.abs() < 0.1,
+            "{reading:?}: {}",
+            before.output_speed_rad_s
+        );
+        let last = r.samples.last().unwrap();
+        assert!(
+            last.output_speed_rad_s > 5.0,
+            "{reading:?}: {}",
+            last.output_speed_rad_s
+        );
+        assert!(m.holding_torque_nm.is_none());
+    }
+}
+
+#[test]
+fn sensor_faults_touch_only_the_readings() {
+    let mut s = Scene::builtin(SceneKind::Drive, Reading::Paper);
+    s.duration_s = 0.1;
+    let r = sim::run(&s).unwrap();
+    let healthy = sensing::trace(&r.samples, &s.sensors, &s.noise, &[], SAMPLE_RATE_HZ);
+    let faults = [
+        Fault {
+            kind: FaultKind::EncoderStuck,
+            at_s: 0.05,
+            severity: 1.0,
+        },
+        Fault {
+            kind: FaultKind::CurrentOpen,
+            at_s: 0.05,
+            severity: 1.0,
+        },
+    ];
+    let faulty = sensing::trace(&r.samples, &s.sensors, &s.noise, &faults, SAMPLE_RATE_HZ);
+    let at = |t: f64| healthy.rows.iter().position(|x| x.t_s >= t).unwrap();
+    let (i0, i1) = (at(0.06), at(0.09));
+    // Healthy: the output encoder moves and the drive draws current.
+    assert_ne!(healthy.rows[i0].output_count, healthy.rows[i1].output_count);
+    assert_ne!(healthy.rows[i1].current_code, 2048);
+    // Faulty: frozen encoder, mid-scale (0 A) current, same truth.
+    assert_eq!(faulty.rows[i0].output_count, faulty.rows[i1].output_count);
+    assert_eq!(faulty.rows[i1].current_code, 2048);
+    assert_eq!(
+        faulty.rows[i1].output_speed_rad_s,
+        healthy.rows[i1].output_speed_rad_s
+    );
+    // Before the fault the traces agree.
+    let early = at(0.04);
+    assert_eq!(faulty.rows[early], healthy.rows[early]);
+}

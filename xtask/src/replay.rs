@@ -1,0 +1,93 @@
+//! Twin traces for the firmware: conversion of the twin's CSV trace to the `NBR1` replay file
+//! the firmware embeds, and the host run of the same replay through the same `Ticker` — the
+//! reference the firmware's digest must equal bit for bit.
+
+use noback::app::{Ticker, Totals};
+use noback::monitor::{Config, Estimate, Inputs, Monitor};
+use noback::replay::{encode_header, encode_record, Replay};
+use noback_twin::trace::Trace;
+
+/// The twin trace of a scene (built-in name or TOML file), physical reading unless the file
+/// says otherwise.
+pub fn twin_trace(target: &str) -> Result<Trace, String> {
+    let scene = noback_twin::cli::load_scene(target, None)?;
+    let run = noback_twin::sim::run(&scene).map_err(|e| format!("twin: {e}"))?;
+    Ok(noback_twin::sensing::trace(
+        &run.samples,
+        &scene.sensors,
+        &scene.noise,
+        &scene.faults,
+        noback_twin::sim::SAMPLE_RATE_HZ,
+    ))
+}
+
+/// The `NBR1` bytes of a trace.
+pub fn nbr1(trace: &Trace) -> Result<Vec<u8>, String> {
+    let count = u32::try_from(trace.rows.len()).map_err(|_| "trace too long")?;
+    let mut bytes = encode_header(count, trace.sample_rate_hz.round() as u32).to_vec();
+    for (i, row) in trace.rows.iter().enumerate() {
+        let inputs = Inputs::new(
+            row.current_code,
+            row.motor_count,
+            row.output_count,
+            row.drive_on,
+        );
+        let record = encode_record(&inputs)
+            .ok_or_else(|| format!("trace row {i}: a counter does not fit 16 bits"))?;
+        bytes.extend_from_slice(&record);
+    }
+    Ok(bytes)
+}
+
+/// The alarm pin of the host run: a latch.
+#[derive(Default)]
+pub struct HostPin(pub bool);
+
+impl embedded_hal::digital::ErrorType for HostPin {
+    type Error = core::convert::Infallible;
+}
+
+impl embedded_hal::digital::OutputPin for HostPin {
+    fn set_low(&mut self) -> Result<(), Self::Error> {
+        self.0 = false;
+        Ok(())
+    }
+    fn set_high(&mut self) -> Result<(), Self::Error> {
+        self.0 = true;
+        Ok(())
+    }
+}
+
+/// What the host run produced.
+pub struct HostRun {
+    /// Every estimate, in tick order.
+    pub estimates: Vec<Estimate>,
+    /// The run's counters and digest.
+    pub totals: Totals,
+}
+
+/// Steps the default monitor over a replay on the host, applying the same missed deadlines
+/// the firmware reported (`(ticks stepped before it, ticks missed)`), so both see identical
+/// inputs.
+pub fn host_run(bytes: &[u8], overruns: &[(u32, u32)]) -> Result<HostRun, String> {
+    let replay = Replay::parse(bytes).map_err(|e| format!("replay: {e:?}"))?;
+    let monitor = Monitor::new(Config::default()).map_err(|e| format!("monitor: {e:?}"))?;
+    let mut ticker = Ticker::new(monitor, replay, HostPin::default());
+    let mut estimates = Vec::new();
+    loop {
+        let stepped = u32::try_from(estimates.len()).unwrap_or(u32::MAX);
+        let n = overruns
+            .iter()
+            .find(|(at, _)| *at == stepped)
+            .map_or(1, |(_, missed)| 1 + (*missed).min(254) as u8);
+        match ticker.tick(n) {
+            Some(estimate) => estimates.push(estimate),
+            None => break,
+        }
+        while ticker.next_event().is_some() {}
+    }
+    Ok(HostRun {
+        estimates,
+        totals: ticker.totals(),
+    })
+}
