@@ -6,3 +6,5 @@
 //! monitor and the twin, which know nothing of each other.
 
 pub mod accuracy;
+pub mod fuzz;
+pub mod mc;

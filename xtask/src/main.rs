@@ -7,7 +7,9 @@ mod bootstrap;
 mod cores;
 mod defmt_log;
 mod elf_size;
+mod fuzz;
 mod monitor;
+mod monitor_mc;
 mod opt_level;
 mod qemu;
 mod replay;
@@ -51,6 +53,14 @@ pub const COMMANDS: &[(&str, &str)] = &[
         "SCENE|FILE [--json] [--out DIR]: the monitor against the twin (accuracy, flags, latency)",
     ),
     (
+        "monitor-mc",
+        "[--runs N] [--fault-runs K] [--seed S] [--json]: detection by Monte Carlo; writes docs/monitor.md",
+    ),
+    (
+        "fuzz",
+        "[TARGET|all] [--seconds N]: the fuzz targets under libFuzzer (nightly, cargo-fuzz)",
+    ),
+    (
         "opt-level",
         "measure flash and instructions at each opt-level; writes docs/results/opt-level.md",
     ),
@@ -81,6 +91,8 @@ fn main() -> ExitCode {
         "paper" => Ok(noback_twin::cli::paper_main(rest)),
         "sweep" => Ok(noback_twin::sweep::sweep_main(rest)),
         "monitor" => monitor::main(rest),
+        "monitor-mc" => monitor_mc::main(rest),
+        "fuzz" => fuzz::main(rest),
         "opt-level" => opt_level::main(rest),
         "bootstrap" => bootstrap::ensure_all().map(|()| 0),
         "-h" | "--help" | "help" => return usage(),

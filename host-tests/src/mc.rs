@@ -1,0 +1,221 @@
+//! Monte Carlo of the monitor's detection: many twin scenes, nominal and faulty, each replayed
+//! through the shipped monitor on the host.
+//!
+//! Nominal draws: a braking, holding or driving scene (reverse_load, forward_load, hold, drive)
+//! with load 5–30 N·m, speed 5–20 rad/s, every mechanism parameter of Table 2 scaled by an
+//! independent factor in [0.9, 1.1], current noise 0–0.1 A, and the load in either direction
+//! (a mirrored run: every sensor reading negated, which is the mechanism's symmetry).
+//! Fault draws: the same, plus one fault of the given kind with onset uniform in the scene and
+//! severity in [0.5, 1]. A fault is detected when a flag that answers its kind
+//! ([`crate::accuracy::expected_flag`]) rises within [`DETECTION_WINDOW_S`] of the moment it
+//! manifests ([`crate::accuracy::manifest_time`]). A nominal run with any flag is a false
+//! alarm. Runs are spread over the machine's cores.
+
+use crate::accuracy::{compare, detection_latency_s, manifest_time, run_monitor};
+use noback::mechanism::Mechanism;
+use noback::monitor::Config;
+use noback_twin::fault::{Fault, FaultKind};
+use noback_twin::reading::Reading;
+use noback_twin::scene::{Scene, SceneKind};
+use noback_twin::sensing::Rng;
+use noback_twin::trace::Trace;
+use std::sync::atomic::{AtomicUsize, Ordering};
+use std::sync::Mutex;
+
+/// A fault counts as detected if flagged within this long after it manifests (s).
+pub const DETECTION_WINDOW_S: f64 = 0.050;
+
+/// Every fault kind of the scene schema.
+pub const FAULT_KINDS: [FaultKind; 8] = [
+    FaultKind::FrictionLoss,
+    FaultKind::SpringBroken,
+    FaultKind::PackWear,
+    FaultKind::RampJam,
+    FaultKind::Drag,
+    FaultKind::EncoderStuck,
+    FaultKind::EncoderJump,
+    FaultKind::CurrentOpen,
+];
+
+/// One drawn run.
+#[derive(Clone, Debug)]
+pub struct Draw {
+    /// The scene (with its fault, if any).
+    pub scene: Scene,
+    /// Whether the sensor readings are mirrored (load in the negative direction).
+    pub mirrored: bool,
+}
+
+/// What one run gave.
+#[derive(Clone, Debug)]
+pub struct Outcome {
+    /// The fault kind, `None` for a nominal run.
+    pub fault: Option<FaultKind>,
+    /// Detection latency (s), if detected at all after manifesting.
+    pub latency_s: Option<f64>,
+    /// Whether the fault manifested within the scene.
+    pub manifested: bool,
+    /// Flags raised before the fault's onset (all flags in a nominal run).
+    pub false_flags: usize,
+    /// The twin failed to run this draw (reported, never silently dropped).
+    pub error: Option<String>,
+}
+
+fn scale_all(m: &mut Mechanism, rng: &mut Rng) {
+    let mut s = |x: &mut f64| *x *= 0.9 + 0.2 * rng.uniform();
+    s(&mut m.output_shaft_mass_kg);
+    s(&mut m.input_shaft_mass_kg);
+    s(&mut m.ball_mass_kg);
+    s(&mut m.connecting_shaft_mass_kg);
+    s(&mut m.output_inertia_kg_m2);
+    s(&mut m.input_inertia_kg_m2);
+    s(&mut m.connecting_inertia_kg_m2);
+    s(&mut m.ball_inertia_kg_m2);
+    s(&mut m.spring_stiffness_n_m);
+    s(&mut m.contact_stiffness);
+    s(&mut m.spring_preload_m);
+    s(&mut m.socket_radius_m);
+    s(&mut m.output_friction_radius_m);
+    s(&mut m.connecting_friction_radius_m);
+    s(&mut m.input_friction_radius_m);
+    s(&mut m.pack_inner_radius_m);
+    s(&mut m.pack_outer_radius_m);
+    s(&mut m.socket_clearance_m);
+    s(&mut m.pack_clearance_m);
+    s(&mut m.socket_chamfer_rad);
+    s(&mut m.mu_static);
+    s(&mut m.mu_dynamic);
+    s(&mut m.restitution);
+}
+
+/// Draws run `index` of a campaign: deterministic in (`seed`, `index`, `fault`).
+pub fn draw(seed: u64, index: u64, fault: Option<FaultKind>) -> Draw {
+    let salt = fault.map_or(0, |k| {
+        1 + FAULT_KINDS.iter().position(|f| *f == k).unwrap_or(0) as u64
+    });
+    let mut rng = Rng::new(seed ^ index.wrapping_mul(0x9E37_79B9_7F4A_7C15) ^ (salt << 56));
+    let kinds = [
+        SceneKind::ReverseLoad,
+        SceneKind::ForwardLoad,
+        SceneKind::Hold,
+        SceneKind::Drive,
+    ];
+    let kind = kinds[(rng.next_u64() % kinds.len() as u64) as usize];
+    let mut scene = Scene::builtin(kind, Reading::Physical);
+    scene.name = format!("mc-{index}");
+    scene.load_torque_nm = 5.0 + 25.0 * rng.uniform();
+    if kind != SceneKind::Hold {
+        scene.initial_speed_rad_s = 5.0 + 15.0 * rng.uniform();
+    }
+    if let Some(release) = scene.release_at_s.as_mut() {
+        *release = 0.1 + 0.2 * rng.uniform();
+    }
+    scale_all(&mut scene.mechanism, &mut rng);
+    scene.noise.seed = rng.next_u64();
+    scene.noise.current_noise_a = 0.1 * rng.uniform();
+    if let Some(kind) = fault {
+        scene.faults.push(Fault {
+            kind,
+            at_s: 0.05 + (scene.duration_s - 0.3).max(0.05) * rng.uniform(),
+            severity: 0.5 + 0.5 * rng.uniform(),
+        });
+    }
+    Draw {
+        scene,
+        mirrored: rng.uniform() < 0.5,
+    }
+}
+
+/// The same trace with the load in the other direction: every reading negated.
+pub fn mirror(trace: &mut Trace, adc_bits: u8, motor_bits: u8, output_bits: u8) {
+    let adc_full = (1_u32 << adc_bits) - 1;
+    let motor_mask = (1_u64 << motor_bits) - 1;
+    let out_mask = (1_u64 << output_bits) - 1;
+    for r in &mut trace.rows {
+        // Offset binary about mid-scale: code c ↦ 2^bits − c, clamped to the converter.
+        let code = (adc_full + 1)
+            .saturating_sub(u32::from(r.current_code))
+            .min(adc_full);
+        r.current_code = code as u16;
+        r.motor_count = ((motor_mask + 1 - u64::from(r.motor_count)) & motor_mask) as u32;
+        r.output_count = ((out_mask + 1 - u64::from(r.output_count)) & out_mask) as u32;
+    }
+}
+
+/// Runs one draw through the twin and the monitor.
+pub fn evaluate(d: &Draw) -> Outcome {
+    let fault = d.scene.faults.first().copied();
+    let fail = |e: String| Outcome {
+        fault: fault.map(|f| f.kind),
+        latency_s: None,
+        manifested: false,
+        false_flags: 0,
+        error: Some(e),
+    };
+    let run = match noback_twin::sim::run(&d.scene) {
+        Ok(run) => run,
+        Err(e) => return fail(format!("{}: twin: {e}", d.scene.name)),
+    };
+    let s = &d.scene.sensors;
+    let mut trace = noback_twin::sensing::trace(
+        &run.samples,
+        s,
+        &d.scene.noise,
+        &d.scene.faults,
+        noback_twin::sim::SAMPLE_RATE_HZ,
+    );
+    if d.mirrored {
+        mirror(
+            &mut trace,
+            s.current_adc_bits,
+            s.motor_counter_bits,
+            s.output_encoder_bits,
+        );
+    }
+    // The monitor is configured with the nominal Table 2, not the drawn mechanism: it must
+    // cope with a ±10 % real part.
+    let estimates = match run_monitor(&trace, Config::default()) {
+        Ok(e) => e,
+        Err(e) => return fail(e),
+    };
+    let acc = compare(&trace, &estimates);
+    let onset = fault.map_or(f64::INFINITY, |f| f.at_s);
+    Outcome {
+        fault: fault.map(|f| f.kind),
+        latency_s: fault.and_then(|f| detection_latency_s(&f, &trace, &acc)),
+        manifested: fault.is_some_and(|f| manifest_time(&f, &trace).is_some()),
+        false_flags: acc.flags.iter().filter(|f| f.t_s < onset).count(),
+        error: None,
+    }
+}
+
+/// Runs every draw on `threads` workers, calling `progress(done, total)` as runs finish.
+pub fn run_all(
+    draws: &[Draw],
+    threads: usize,
+    progress: &(dyn Fn(usize, usize) + Sync),
+) -> Vec<Outcome> {
+    let next = AtomicUsize::new(0);
+    let results = Mutex::new(vec![None; draws.len()]);
+    std::thread::scope(|scope| {
+        for _ in 0..threads.max(1) {
+            scope.spawn(|| loop {
+                let i = next.fetch_add(1, Ordering::Relaxed);
+                let Some(d) = draws.get(i) else { break };
+                let outcome = evaluate(d);
+                let done = {
+                    let mut r = results.lock().unwrap_or_else(|p| p.into_inner());
+                    r[i] = Some(outcome);
+                    r.iter().filter(|o| o.is_some()).count()
+                };
+                progress(done, draws.len());
+            });
+        }
+    });
+    results
+        .into_inner()
+        .unwrap_or_else(|p| p.into_inner())
+        .into_iter()
+        .flatten()
+        .collect()
+}
