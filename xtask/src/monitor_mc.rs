@@ -70,7 +70,7 @@ pub fn main(args: &[String]) -> Result<i32, String> {
         a.seed
     );
     let progress = |done: usize, total: usize| {
-        if done % 50 == 0 || done == total {
+        if done.is_multiple_of(50) || done == total {
             eprint!("\r  {done}/{total} runs");
             let _ = std::io::stderr().flush();
         }
