@@ -8,3 +8,4 @@
 pub mod accuracy;
 pub mod fuzz;
 pub mod mc;
+pub mod robustness;

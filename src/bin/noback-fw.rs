@@ -48,6 +48,8 @@ mod target {
     static DONE: AtomicBool = AtomicBool::new(false);
     static OVERRUN_AT: AtomicU32 = AtomicU32::new(u32::MAX);
     static TICK_NO: AtomicU32 = AtomicU32::new(0);
+    /// Most SysTick ticks from a tick's start to the end of its handler (deadline use).
+    static ISR_TICKS_MAX: AtomicU32 = AtomicU32::new(0);
 
     /// The alarm output. Under QEMU a plain latch; a board passes its GPIO's `OutputPin`.
     pub struct AlarmPin {
@@ -178,7 +180,7 @@ mod target {
         let t = app.totals();
         let last = app.last_estimate();
         defmt::info!(
-            "summary ticks={=u32} overruns={=u32} missed={=u32} log_overwritten={=u32} alarm_errors={=u32} flags={=u8:#04x} stack_bytes={=u32} digest={=u32:#010x}",
+            "summary ticks={=u32} overruns={=u32} missed={=u32} log_overwritten={=u32} alarm_errors={=u32} flags={=u8:#04x} stack_bytes={=u32} isr_ticks_max={=u32} period_ticks={=u32} digest={=u32:#010x}",
             t.ticks,
             t.overruns,
             t.missed_ticks,
@@ -186,6 +188,8 @@ mod target {
             t.alarm_errors,
             last.map_or(0, |e| e.flags.bits()),
             stack::high_water_bytes(),
+            ISR_TICKS_MAX.load(Ordering::Relaxed),
+            CLOCK_HZ / TICK_HZ,
             t.digest
         );
         platform::exit(noback::exit_code::SUCCESS)
@@ -247,6 +251,13 @@ mod target {
         // The next SysTick already pending means this handler ran past its deadline.
         if SCB::is_pendst_pending() {
             ELAPSED.store(2, Ordering::Relaxed);
+        } else {
+            // Time used of this period, entry latency included: SysTick counts down from the
+            // reload value, which it reloaded when this tick began.
+            let used = (CLOCK_HZ / TICK_HZ - 1).saturating_sub(SYST::get_current());
+            if used > ISR_TICKS_MAX.load(Ordering::Relaxed) {
+                ISR_TICKS_MAX.store(used, Ordering::Relaxed);
+            }
         }
     }
 }

@@ -12,6 +12,7 @@ mod monitor;
 mod monitor_mc;
 mod opt_level;
 mod qemu;
+mod reliability;
 mod replay;
 mod run;
 mod shell;
@@ -65,6 +66,10 @@ pub const COMMANDS: &[(&str, &str)] = &[
         "measure flash and instructions at each opt-level; writes docs/results/opt-level.md",
     ),
     (
+        "reliability",
+        "input classes, fuzzing, panic-never proof; writes docs/reliability.md",
+    ),
+    (
         "bootstrap",
         "add missing rustup targets and install qemu-system-arm if missing",
     ),
@@ -94,6 +99,7 @@ fn main() -> ExitCode {
         "monitor-mc" => monitor_mc::main(rest),
         "fuzz" => fuzz::main(rest),
         "opt-level" => opt_level::main(rest),
+        "reliability" => reliability::main(rest),
         "bootstrap" => bootstrap::ensure_all().map(|()| 0),
         "-h" | "--help" | "help" => return usage(),
         other => {

@@ -188,6 +188,8 @@ pub fn replay_report(
     let size = elf_size::of_file(&elf)?;
     let flash_bytes = size.flash_bytes.saturating_sub(bytes.len() as u64);
     let stack_bytes: u32 = field(&summary, "stack_bytes")?;
+    let isr_ticks_max: f64 = field::<u32>(&summary, "isr_ticks_max")?.into();
+    let period_ticks: f64 = field::<u32>(&summary, "period_ticks")?.into();
 
     let flags: Vec<_> =
         realtime
@@ -237,6 +239,8 @@ pub fn replay_report(
         "flags": flags,
         "insns_per_step_mean": (insns_mean * 10.0).round() / 10.0,
         "insns_per_step_max": insns_max.round(),
+        "isr_insns_max": (isr_ticks_max / core.ticks_per_insn(REALTIME_SHIFT)).round(),
+        "deadline_used_pct": (1000.0 * isr_ticks_max / period_ticks).round() / 10.0,
         "flash_bytes": flash_bytes,
         "replay_bytes": bytes.len(),
         "ram_bytes": size.ram_bytes,
@@ -270,6 +274,10 @@ fn print_summary(r: &serde_json::Value) {
     println!(
         "instructions per step: mean {}, max {} (QEMU -icount, bench boot)",
         r["insns_per_step_mean"], r["insns_per_step_max"]
+    );
+    println!(
+        "whole tick (interrupt entry to exit, real-time boot): at most {} instructions, {} % of the 100 µs deadline",
+        r["isr_insns_max"], r["deadline_used_pct"]
     );
     println!(
         "flash {} B (+ {} B replay data), static RAM {} B, stack high-water {} B",
