@@ -7,7 +7,8 @@
 //! - `realtime` (default): SysTick interrupts at 10 kHz; each interrupt steps the monitor on
 //!   the next sample and drives the alarm pin; the main loop drains the log ring buffer to
 //!   defmt, so logging never blocks the interrupt. `overrun-at=N` burns time in tick N to
-//!   provoke a missed deadline, which must be counted and flagged.
+//!   provoke a missed deadline, which must be counted and flagged; `reset-every=N` has the
+//!   operator reset the flags after every N-th tick (the load test: flags keep changing).
 //! - `bench`: the same monitor steps back to back without interrupts, each `Monitor::step`
 //!   measured alone with SysTick, for deterministic instruction counts under QEMU `-icount`.
 //!
@@ -47,6 +48,8 @@ mod target {
     static ELAPSED: AtomicU8 = AtomicU8::new(1);
     static DONE: AtomicBool = AtomicBool::new(false);
     static OVERRUN_AT: AtomicU32 = AtomicU32::new(u32::MAX);
+    /// Operator flag reset after every this many ticks (0 = never); the load test uses it.
+    static RESET_EVERY: AtomicU32 = AtomicU32::new(0);
     static TICK_NO: AtomicU32 = AtomicU32::new(0);
     /// Most SysTick ticks from a tick's start to the end of its handler (deadline use).
     static ISR_TICKS_MAX: AtomicU32 = AtomicU32::new(0);
@@ -86,6 +89,8 @@ mod target {
                     bench = true;
                 } else if let Some(n) = arg.strip_prefix("overrun-at=") {
                     OVERRUN_AT.store(n.parse().unwrap_or(u32::MAX), Ordering::Relaxed);
+                } else if let Some(n) = arg.strip_prefix("reset-every=") {
+                    RESET_EVERY.store(n.parse().unwrap_or(0), Ordering::Relaxed);
                 }
             }
         }
@@ -233,13 +238,17 @@ mod target {
         ELAPSED.store(1, Ordering::Relaxed);
         let tick_no = TICK_NO.load(Ordering::Relaxed);
         TICK_NO.store(tick_no.wrapping_add(1), Ordering::Relaxed);
+        let reset_every = RESET_EVERY.load(Ordering::Relaxed);
         let stepped = critical_section::with(|cs| {
-            APP.borrow(cs)
-                .borrow_mut()
-                .as_mut()
-                .and_then(|app| app.tick(n))
-                .is_some()
-        });
+            let mut app = APP.borrow(cs).borrow_mut();
+            let app = app.as_mut()?;
+            let estimate = app.tick(n);
+            if reset_every != 0 && tick_no.wrapping_add(1) % reset_every == 0 {
+                app.reset_flags();
+            }
+            estimate
+        })
+        .is_some();
         if !stepped {
             DONE.store(true, Ordering::Release);
         }

@@ -21,6 +21,36 @@ pub fn twin_trace(target: &str) -> Result<Trace, String> {
     ))
 }
 
+/// Name of the synthetic stress replay (`cargo xtask run --scene stress`).
+pub const STRESS: &str = "stress";
+
+/// A synthetic second of hostile inputs for the load test: the drive flag toggling every 37
+/// ticks, the current sweeping rail to rail and sitting on a rail, the output encoder jumping,
+/// the motor counter stalling. Truth columns are zero (there is no physics behind it).
+pub fn stress_trace() -> Trace {
+    let rows = (0..10_000_u32)
+        .map(|i| {
+            let drive = (i / 37) % 2 == 0;
+            let sweep = (i % 200) * 4095 / 199;
+            let code = if i % 500 < 40 { 4095 } else { sweep };
+            let out = (i + 3000 * (i / 1000)) % (1 << 14);
+            let motor = if drive { (i * 8) % (1 << 16) } else { 0 };
+            noback_twin::trace::TraceRow {
+                t_s: f64::from(i) * 1e-4,
+                current_code: code as u16,
+                motor_count: motor,
+                output_count: out,
+                drive_on: drive,
+                ..Default::default()
+            }
+        })
+        .collect();
+    Trace {
+        sample_rate_hz: 10_000.0,
+        rows,
+    }
+}
+
 /// The `NBR1` bytes of a trace.
 pub fn nbr1(trace: &Trace) -> Result<Vec<u8>, String> {
     let count = u32::try_from(trace.rows.len()).map_err(|_| "trace too long")?;
@@ -67,9 +97,13 @@ pub struct HostRun {
 }
 
 /// Steps the default monitor over a replay on the host, applying the same missed deadlines
-/// the firmware reported (`(ticks stepped before it, ticks missed)`), so both see identical
-/// inputs.
-pub fn host_run(bytes: &[u8], overruns: &[(u32, u32)]) -> Result<HostRun, String> {
+/// the firmware reported (`(ticks stepped before it, ticks missed)`) and the same operator
+/// resets (after every `reset_every`-th tick), so both see identical inputs.
+pub fn host_run(
+    bytes: &[u8],
+    overruns: &[(u32, u32)],
+    reset_every: Option<u32>,
+) -> Result<HostRun, String> {
     let replay = Replay::parse(bytes).map_err(|e| format!("replay: {e:?}"))?;
     let monitor = Monitor::new(Config::default()).map_err(|e| format!("monitor: {e:?}"))?;
     let mut ticker = Ticker::new(monitor, replay, HostPin::default());
@@ -83,6 +117,9 @@ pub fn host_run(bytes: &[u8], overruns: &[(u32, u32)]) -> Result<HostRun, String
         match ticker.tick(n) {
             Some(estimate) => estimates.push(estimate),
             None => break,
+        }
+        if reset_every.is_some_and(|every| every > 0 && (stepped + 1) % every == 0) {
+            ticker.reset_flags();
         }
         while ticker.next_event().is_some() {}
     }

@@ -10,12 +10,15 @@
 
 use crate::cores::Core;
 use crate::qemu::{self, Boot, Outcome};
-use crate::replay::{host_run, nbr1, twin_trace};
+use crate::replay::{host_run, nbr1, stress_trace, twin_trace, STRESS};
 use crate::shell::{self, cargo, workspace_root};
 use crate::{bootstrap, elf_size, test::BOOT_TIMEOUT};
 use noback::monitor::Flags;
 use serde_json::json;
 use std::collections::BTreeMap;
+
+/// In the stress run the operator "resets" the flags this often (ticks), so they keep changing.
+pub const STRESS_RESET_EVERY: u32 = 50;
 
 /// Real-time boot: 2^4 ns = 16 ns per instruction.
 pub const REALTIME_SHIFT: u32 = 4;
@@ -51,7 +54,7 @@ fn parse(args: &[String]) -> Result<Args, String> {
             }
             other => {
                 return Err(format!(
-                    "unknown argument `{other}` (run [--scene NAME|FILE] [--core m0|m3|m4f] [--json] [--overrun-at TICK])"
+                    "unknown argument `{other}` (run [--scene NAME|FILE|stress] [--core m0|m3|m4f] [--json] [--overrun-at TICK])"
                 ))
             }
         }
@@ -115,7 +118,8 @@ fn flag_names(bits: u8) -> Vec<&'static str> {
 pub fn main(args: &[String]) -> Result<i32, String> {
     let a = parse(args)?;
     bootstrap::ensure_all()?;
-    let (report, ok) = replay_report(&a.scene, a.core, a.overrun_at, !a.json)?;
+    let reset_every = (a.scene == STRESS).then_some(STRESS_RESET_EVERY);
+    let (report, ok) = replay_report(&a.scene, a.core, a.overrun_at, reset_every, !a.json)?;
     if a.json {
         println!("{report}");
     } else {
@@ -130,12 +134,17 @@ pub fn replay_report(
     scene: &str,
     core: Core,
     overrun_at: Option<u32>,
+    reset_every: Option<u32>,
     echo: bool,
 ) -> Result<(serde_json::Value, bool), String> {
-    if echo {
-        println!("twin: scene `{}` (physical reading)", scene);
-    }
-    let trace = twin_trace(scene)?;
+    let trace = if scene == STRESS {
+        stress_trace()
+    } else {
+        if echo {
+            println!("twin: scene `{scene}` (physical reading)");
+        }
+        twin_trace(scene)?
+    };
     let bytes = nbr1(&trace)?;
     let dir = workspace_root().join("target").join("replay");
     std::fs::create_dir_all(&dir).map_err(|e| e.to_string())?;
@@ -158,6 +167,9 @@ pub fn replay_report(
     if let Some(n) = overrun_at {
         rt_args.push(format!("overrun-at={n}"));
     }
+    if let Some(n) = reset_every {
+        rt_args.push(format!("reset-every={n}"));
+    }
     let realtime = boot(core, &elf, REALTIME_SHIFT, rt_args, echo)?;
     let bench = boot(core, &elf, BENCH_SHIFT, vec!["bench".into()], false)?;
 
@@ -172,8 +184,8 @@ pub fn replay_report(
             Ok((field(&f, "tick")?, field(&f, "missed")?))
         })
         .collect::<Result<_, String>>()?;
-    let host = host_run(&bytes, &overruns)?;
-    let host_plain = host_run(&bytes, &[])?;
+    let host = host_run(&bytes, &overruns, reset_every)?;
+    let host_plain = host_run(&bytes, &[], None)?;
     let fw_digest = hex(&summary, "digest")?;
     let bench_digest = hex(&bench_line, "digest")?;
     let bit_exact = fw_digest == host.totals.digest && bench_digest == host_plain.totals.digest;

@@ -91,7 +91,7 @@ pub fn main(args: &[String]) -> Result<i32, String> {
             "firmware replaying `{SNAPSHOT_SCENE}` under QEMU ({}, release)",
             core.name()
         ));
-        let (report, ok) = run::replay_report(SNAPSHOT_SCENE, core, None, false)?;
+        let (report, ok) = run::replay_report(SNAPSHOT_SCENE, core, None, None, false)?;
         println!(
             "ticks {}, overruns {}, flags {}, {} instructions/step max, bit-exact {}",
             report["ticks"],
@@ -110,6 +110,8 @@ pub fn main(args: &[String]) -> Result<i32, String> {
             snapshot::check(&report, bless)?;
             section("provoked overrun (m3)");
             overrun_is_counted_and_flagged()?;
+            section("load: hostile inputs, flags reset every 50 ticks (m3)");
+            stress_stays_within_its_deadline()?;
         }
         let fw_digest = u32::from_str_radix(
             report["fx_selfcheck_digest"]
@@ -189,7 +191,8 @@ const OVERRUN_TICK: u32 = 3000;
 
 /// Provokes one missed deadline and checks it is counted, flagged and replayed identically.
 fn overrun_is_counted_and_flagged() -> Result<(), String> {
-    let (report, ok) = run::replay_report(SNAPSHOT_SCENE, Core::M3, Some(OVERRUN_TICK), false)?;
+    let (report, ok) =
+        run::replay_report(SNAPSHOT_SCENE, Core::M3, Some(OVERRUN_TICK), None, false)?;
     let overruns = report["overruns"].as_u64().unwrap_or(0);
     let flagged = report["flags"]
         .as_array()
@@ -208,6 +211,46 @@ fn overrun_is_counted_and_flagged() -> Result<(), String> {
         Ok(())
     } else {
         Err("the provoked overrun was not counted once, flagged on the next tick and replayed bit-exactly".into())
+    }
+}
+
+/// The heaviest path — every flag changing, a burst of flag events, hostile inputs — must stay
+/// inside the deadline, count what the log overwrote, and stay bit-exact with the host.
+fn stress_stays_within_its_deadline() -> Result<(), String> {
+    let (report, ok) = run::replay_report(
+        crate::replay::STRESS,
+        Core::M3,
+        None,
+        Some(run::STRESS_RESET_EVERY),
+        false,
+    )?;
+    let kinds: std::collections::BTreeSet<&str> = report["flags"]
+        .as_array()
+        .into_iter()
+        .flatten()
+        .filter_map(|f| f["flag"].as_str())
+        .collect();
+    let raised = report["flags"].as_array().map_or(0, Vec::len);
+    println!(
+        "stress: {} flag raisings of {:?}, overruns {}, log events overwritten {}, whole tick at most {} instructions ({} % of the deadline), bit-exact {}",
+        raised,
+        kinds,
+        report["overruns"],
+        report["log_overwritten"],
+        report["isr_insns_max"],
+        report["deadline_used_pct"],
+        report["bit_exact"]
+    );
+    let used = report["deadline_used_pct"]
+        .as_f64()
+        .unwrap_or(f64::INFINITY);
+    if ok && report["overruns"] == 0 && used < 100.0 && raised > 10 && !kinds.is_empty() {
+        Ok(())
+    } else {
+        Err(
+            "the load test missed its deadline, lost bit-exactness or did not load the flag path"
+                .into(),
+        )
     }
 }
 
