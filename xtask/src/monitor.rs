@@ -1,5 +1,5 @@
-//! `cargo xtask monitor SCENE|FILE [--json] [--out DIR]` — the monitor against the twin on one
-//! scene: accuracy figures, flags, detection latency per injected fault, false alarms, and a
+//! `cargo xtask monitor SCENE|SCENE.toml|TRACE.csv [--json] [--out DIR]` — the monitor against
+//! the twin on one scene (or on a recorded trace): accuracy figures, flags, detection latency per injected fault, false alarms, and a
 //! plot with the twin's raw and compared signals beside the monitor's estimate.
 //! The comparison itself lives in `host_tests::accuracy` (this file only runs and reports).
 
@@ -10,6 +10,10 @@ use host_tests::accuracy::{
 };
 use noback::monitor::Config;
 use noback_twin::svg::{render, Panel, Series};
+use noback_twin::trace::Trace;
+
+/// Exit code for a bad scene, trace or command line (the twin's tools use the same).
+pub const EXIT_INPUT: i32 = 2;
 use serde_json::json;
 use std::path::PathBuf;
 
@@ -27,14 +31,34 @@ pub fn main(args: &[String]) -> Result<i32, String> {
             s => target = Some(s.to_string()),
         }
     }
-    let target = target.ok_or("usage: cargo xtask monitor SCENE|FILE [--json] [--out DIR]")?;
-    let scene = noback_twin::cli::load_scene(&target, None)?;
-    let trace = twin_trace(&target)?;
+    let Some(target) = target else {
+        eprintln!(
+            "error: usage: cargo xtask monitor SCENE|SCENE.toml|TRACE.csv [--json] [--out DIR]"
+        );
+        return Ok(EXIT_INPUT);
+    };
+    // A trace file (the twin's CSV format) is replayed as it is; anything else is a scene.
+    let (faults, trace) = if target.ends_with(".csv") {
+        match Trace::read(std::path::Path::new(&target)) {
+            Ok(trace) => (Vec::new(), trace),
+            Err(e) => {
+                eprintln!("error: {target}: {e}");
+                return Ok(EXIT_INPUT);
+            }
+        }
+    } else {
+        match noback_twin::cli::load_scene(&target, None) {
+            Ok(scene) => (scene.faults.clone(), twin_trace(&target)?),
+            Err(e) => {
+                eprintln!("error: {e}");
+                return Ok(EXIT_INPUT);
+            }
+        }
+    };
     let estimates = run_monitor(&trace, Config::default())?;
     let acc = compare(&trace, &estimates);
 
-    let detections: Vec<_> = scene
-        .faults
+    let detections: Vec<_> = faults
         .iter()
         .map(|f| {
             json!({
@@ -65,7 +89,7 @@ pub fn main(args: &[String]) -> Result<i32, String> {
         "lock_time_err_s": acc.lock_time_err_s().filter(|e| e.is_finite()),
         "flags": flags,
         "detection_latency_s": detections,
-        "false_alarms": false_alarms(&scene.faults, &acc),
+        "false_alarms": false_alarms(&faults, &acc),
     });
 
     std::fs::create_dir_all(&out).map_err(|e| format!("{}: {e}", out.display()))?;
@@ -131,4 +155,35 @@ pub fn main(args: &[String]) -> Result<i32, String> {
         eprintln!("plot: {}", svg_path.display());
     }
     Ok(0)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn write(name: &str, text: &str) -> String {
+        let dir = std::env::temp_dir().join(format!("noback-xtask-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let path = dir.join(name);
+        std::fs::write(&path, text).unwrap();
+        path.to_string_lossy().into_owned()
+    }
+
+    #[test]
+    fn bad_inputs_exit_with_code_2() {
+        let out = std::env::temp_dir().to_string_lossy().into_owned();
+        let run = |target: &str| main(&[target.to_string(), "--out".into(), out.clone()]);
+        // Unknown scene name, truncated trace, trace from another version.
+        assert_eq!(run("no_such_scene"), Ok(EXIT_INPUT));
+        let header = noback_twin::trace::HEADER;
+        let cols = noback_twin::trace::COLUMNS.join(",");
+        let truncated = write(
+            "truncated.trace.csv",
+            &format!("{header}\n# sample_rate_hz=10000\n{cols}\n0.0000,2048,0,0,1,169.2"),
+        );
+        assert_eq!(run(&truncated), Ok(EXIT_INPUT));
+        let other = write("other.trace.csv", &format!("# noback-trace v9\n{cols}\n"));
+        assert_eq!(run(&other), Ok(EXIT_INPUT));
+        assert_eq!(main(&[]), Ok(EXIT_INPUT));
+    }
 }
