@@ -24,6 +24,20 @@ pub const HOLD_WINDOW_S: f64 = 0.050;
 /// How long a lock must last to count (s).
 pub const LOCK_CONFIRM_S: f64 = 0.020;
 
+/// The twin's 10 kHz sensor trace of a scene (built-in name or TOML file), physical reading
+/// unless the file says otherwise.
+pub fn twin_trace(target: &str) -> Result<Trace, String> {
+    let scene = noback_twin::cli::load_scene(target, None)?;
+    let run = noback_twin::sim::run(&scene).map_err(|e| format!("twin: {e}"))?;
+    Ok(noback_twin::sensing::trace(
+        &run.samples,
+        &scene.sensors,
+        &scene.noise,
+        &scene.faults,
+        noback_twin::sim::SAMPLE_RATE_HZ,
+    ))
+}
+
 /// Runs the monitor over every row of a trace.
 pub fn run_monitor(trace: &Trace, config: Config) -> Result<Vec<Estimate>, String> {
     let mut monitor = Monitor::new(config).map_err(|e| format!("monitor config: {e:?}"))?;

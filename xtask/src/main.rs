@@ -8,6 +8,7 @@ mod cores;
 mod defmt_log;
 mod elf_size;
 mod fuzz;
+mod golden;
 mod monitor;
 mod monitor_mc;
 mod opt_level;
@@ -62,6 +63,10 @@ pub const COMMANDS: &[(&str, &str)] = &[
         "[TARGET|all] [--seconds N]: the fuzz targets under libFuzzer (nightly, cargo-fuzz)",
     ),
     (
+        "golden",
+        "regenerate the golden twin traces in host-tests/golden/",
+    ),
+    (
         "opt-level",
         "measure flash and instructions at each opt-level; writes docs/results/opt-level.md",
     ),
@@ -98,6 +103,7 @@ fn main() -> ExitCode {
         "monitor" => monitor::main(rest),
         "monitor-mc" => monitor_mc::main(rest),
         "fuzz" => fuzz::main(rest),
+        "golden" => golden::main(rest),
         "opt-level" => opt_level::main(rest),
         "reliability" => reliability::main(rest),
         "bootstrap" => bootstrap::ensure_all().map(|()| 0),

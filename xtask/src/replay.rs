@@ -2,24 +2,11 @@
 //! the firmware embeds, and the host run of the same replay through the same `Ticker` — the
 //! reference the firmware's digest must equal bit for bit.
 
+pub use host_tests::accuracy::twin_trace;
 use noback::app::{Ticker, Totals};
 use noback::monitor::{Config, Estimate, Inputs, Monitor};
 use noback::replay::{encode_header, encode_record, Replay};
 use noback_twin::trace::Trace;
-
-/// The twin trace of a scene (built-in name or TOML file), physical reading unless the file
-/// says otherwise.
-pub fn twin_trace(target: &str) -> Result<Trace, String> {
-    let scene = noback_twin::cli::load_scene(target, None)?;
-    let run = noback_twin::sim::run(&scene).map_err(|e| format!("twin: {e}"))?;
-    Ok(noback_twin::sensing::trace(
-        &run.samples,
-        &scene.sensors,
-        &scene.noise,
-        &scene.faults,
-        noback_twin::sim::SAMPLE_RATE_HZ,
-    ))
-}
 
 /// Name of the synthetic stress replay (`cargo xtask run --scene stress`).
 pub const STRESS: &str = "stress";
