@@ -9,6 +9,8 @@
 //!   capacity), written once and used by the twin in f64 and by the monitor in fixed point.
 //! - [`sensors`]: motor, reducer, ADC and encoder defaults shared by twin and monitor.
 //! - [`monitor`]: the 10 kHz reduced model, observer and failure flags.
+//! - [`reduced`]: the reduced output-shaft model, generic over number format and integrator
+//!   (the candidates of the speed-against-accuracy study, docs/speed-accuracy.md).
 //! - [`fx`]: fixed-point formats and the small saturating/wrapping helpers the monitor uses.
 //! - [`vectors`]: test vectors run natively and under QEMU; the xtask compares the two digests.
 //! - [`board`], [`replay`], [`app`], [`event_log`]: the firmware's portable half — sensor
@@ -26,6 +28,7 @@ pub mod exit_code;
 pub mod fx;
 pub mod mechanism;
 pub mod monitor;
+pub mod reduced;
 pub mod replay;
 pub mod sensors;
 pub mod vectors;

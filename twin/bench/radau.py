@@ -183,10 +183,15 @@ def run(scene, tol):
             g0 = m.event_values(y)
 
             def make(i):
+                # Only a strict sign change from a non-zero start value is an event (as in the
+                # twin); a function that starts at (rounding) zero is ignored until the next
+                # restart.
+                sign0 = 1.0 if g0[i] > 1e-15 else (-1.0 if g0[i] < -1e-15 else 0.0)
+
                 def ev(tt, yy):
-                    v = m.event_values(yy)[i]
-                    # a sign change relative to the start value
-                    return v if g0[i] != 0 else 1.0
+                    if sign0 == 0.0:
+                        return 1.0
+                    return m.event_values(yy)[i]
                 ev.terminal = True
                 return ev
 
@@ -203,8 +208,16 @@ def run(scene, tol):
                 grid_a.append(ys[TS])
                 next_sample += 1e-4
             y = sol.y[:, -1].copy()
+            stalled = t_end - t < 1e-12
             t = t_end
-            if sol.status == 1:
+            if sol.status == 1 and stalled:
+                # An event at the restart point (rounding): step past it without events.
+                nudge = solve_ivp(m.rhs, (t, min(t + 1e-9, b)), y, method="Radau", rtol=tol)
+                nfev += nudge.nfev
+                y = nudge.y[:, -1].copy()
+                t = nudge.t[-1]
+                m.on_event(y)
+            elif sol.status == 1:
                 nevents += 1
                 # step just past the root so the sign has changed
                 m.on_event(y)

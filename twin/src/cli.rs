@@ -17,6 +17,8 @@ use crate::svg::{self, Panel, Series};
 use std::io::Write;
 use std::path::{Path, PathBuf};
 
+pub use crate::sweep::sweep_main;
+
 /// Exit code of a usage or input error.
 pub const EXIT_USAGE: i32 = 2;
 

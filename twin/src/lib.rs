@@ -12,6 +12,7 @@ pub mod pack;
 pub mod paper_table;
 pub mod reading;
 pub mod scene;
+pub mod scene_file;
 pub mod sensing;
 pub mod sim;
 pub mod solver;

@@ -288,7 +288,15 @@ pub fn table_from(runs: &[Metrics], mech: &Mechanism) -> PaperTable {
 
 fn cell(v: Option<f64>, paper: f64) -> (String, String) {
     match v {
-        Some(v) => (sig(v), format!("{:+.0} %", 100.0 * deviation(v, paper))),
+        Some(v) => {
+            let d = (100.0 * deviation(v, paper)).round();
+            let d = if d == 0.0 {
+                "0 %".to_string()
+            } else {
+                format!("{d:+.0} %")
+            };
+            (sig(v), d)
+        }
         None => ("—".to_string(), "—".to_string()),
     }
 }

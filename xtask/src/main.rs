@@ -3,6 +3,7 @@
 //! Each command is one file; this one parses the command line and dispatches. The README's two
 //! commands are `cargo xtask run` (the main job) and `cargo xtask test` (every test).
 
+mod bench;
 mod bootstrap;
 mod cores;
 mod defmt_log;
@@ -21,6 +22,7 @@ mod snapshot;
 mod test;
 #[cfg(test)]
 mod tidy;
+mod twin_bench;
 
 use std::process::ExitCode;
 
@@ -41,6 +43,10 @@ pub const COMMANDS: &[(&str, &str)] = &[
     (
         "twin",
         "SCENE|FILE [--reading paper|physical] [--out DIR] [--json]: run the digital twin",
+    ),
+    (
+        "twin-bench",
+        "[--tolerance TOL] [--no-scipy]: twin speed against scipy Radau; writes docs/results/twin-speed.md",
     ),
     (
         "paper",
@@ -75,6 +81,10 @@ pub const COMMANDS: &[(&str, &str)] = &[
         "input classes, fuzzing, panic-never proof; writes docs/reliability.md",
     ),
     (
+        "bench",
+        "[--quick] [--json]: speed against accuracy; writes docs/results/speed-accuracy.*, stability.*, cheapest-per-scene.md",
+    ),
+    (
         "bootstrap",
         "add missing rustup targets and install qemu-system-arm if missing",
     ),
@@ -99,6 +109,7 @@ fn main() -> ExitCode {
         "qemu" => qemu::main(rest),
         "twin" => Ok(noback_twin::cli::twin_main(rest)),
         "paper" => Ok(noback_twin::cli::paper_main(rest)),
+        "twin-bench" => twin_bench::main(rest),
         "sweep" => Ok(noback_twin::sweep::sweep_main(rest)),
         "monitor" => monitor::main(rest),
         "monitor-mc" => monitor_mc::main(rest),
@@ -106,6 +117,7 @@ fn main() -> ExitCode {
         "golden" => golden::main(rest),
         "opt-level" => opt_level::main(rest),
         "reliability" => reliability::main(rest),
+        "bench" => bench::main(rest),
         "bootstrap" => bootstrap::ensure_all().map(|()| 0),
         "-h" | "--help" | "help" => return usage(),
         other => {

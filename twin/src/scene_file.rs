@@ -1,0 +1,412 @@
+//! The TOML scene-file schema (docs/model.md, "Scene files"): raw `serde` structs with
+//! `deny_unknown_fields`, and the checks that turn them into a [`Scene`], each error naming the
+//! key (`scene.duration_s`, `mechanism.restitution`, `fault[0].severity`).
+
+use crate::fault::{Fault, FaultKind};
+use crate::reading::Reading;
+use crate::scene::{Scene, SceneError, SceneKind};
+use serde::Deserialize;
+
+/// Parse the text of a scene file.
+pub fn parse(name: &str, text: &str) -> Result<Scene, SceneError> {
+    let raw: RawFile = toml::from_str(text).map_err(|e| SceneError {
+        key: String::new(),
+        message: e.to_string().trim().to_string(),
+    })?;
+    raw.into_scene(name)
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawFile {
+    scene: RawScene,
+    #[serde(default)]
+    mechanism: RawMechanism,
+    #[serde(default)]
+    sensors: RawSensors,
+    #[serde(default)]
+    open: RawOpen,
+    #[serde(default)]
+    fault: Vec<RawFault>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawScene {
+    kind: String,
+    reading: Option<String>,
+    load_torque_nm: Option<f64>,
+    initial_speed_rad_s: Option<f64>,
+    release_at_s: Option<f64>,
+    duration_s: Option<f64>,
+    tolerance: Option<f64>,
+}
+
+#[derive(Deserialize, Default)]
+#[serde(deny_unknown_fields)]
+struct RawMechanism {
+    output_shaft_mass_kg: Option<f64>,
+    input_shaft_mass_kg: Option<f64>,
+    ball_mass_kg: Option<f64>,
+    connecting_shaft_mass_kg: Option<f64>,
+    output_inertia_kg_m2: Option<f64>,
+    input_inertia_kg_m2: Option<f64>,
+    connecting_inertia_kg_m2: Option<f64>,
+    ball_inertia_kg_m2: Option<f64>,
+    spring_stiffness_n_m: Option<f64>,
+    contact_stiffness: Option<f64>,
+    spring_preload_m: Option<f64>,
+    socket_radius_m: Option<f64>,
+    output_friction_radius_m: Option<f64>,
+    connecting_friction_radius_m: Option<f64>,
+    input_friction_radius_m: Option<f64>,
+    pack_inner_radius_m: Option<f64>,
+    pack_outer_radius_m: Option<f64>,
+    socket_clearance_m: Option<f64>,
+    pack_clearance_m: Option<f64>,
+    socket_chamfer_rad: Option<f64>,
+    friction_discs: Option<u8>,
+    mu_static: Option<f64>,
+    mu_dynamic: Option<f64>,
+    restitution: Option<f64>,
+    groove_angle_rad: Option<f64>,
+}
+
+#[derive(Deserialize, Default)]
+#[serde(deny_unknown_fields)]
+struct RawSensors {
+    motor_torque_constant_nm_a: Option<f64>,
+    reducer_ratio: Option<f64>,
+    reducer_efficiency: Option<f64>,
+    current_adc_bits: Option<u8>,
+    current_full_scale_a: Option<f64>,
+    motor_encoder_counts_per_rev: Option<u32>,
+    output_encoder_bits: Option<u8>,
+    motor_counter_bits: Option<u8>,
+    noise_seed: Option<u64>,
+    current_noise_a: Option<f64>,
+}
+
+#[derive(Deserialize, Default)]
+#[serde(deny_unknown_fields)]
+struct RawOpen {
+    approach_speed_floor_m_s: Option<f64>,
+    drive_gain_nm_s_rad: Option<f64>,
+    reflected_motor_inertia_kg_m2: Option<f64>,
+    bearing_smoothing_rad_s: Option<f64>,
+    axial_smoothing_m_s: Option<f64>,
+    shaft_gap_m: Option<f64>,
+    stop_threshold_rad_s: Option<f64>,
+    paper_far_face_stop: Option<bool>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawFault {
+    kind: String,
+    at_s: f64,
+    severity: f64,
+}
+
+fn bad(key: &str, message: String) -> SceneError {
+    SceneError {
+        key: key.to_string(),
+        message,
+    }
+}
+
+/// Take `v` if set, checking `lo <= v <= hi` (and finiteness).
+fn ranged(target: &mut f64, v: Option<f64>, key: &str, lo: f64, hi: f64) -> Result<(), SceneError> {
+    if let Some(v) = v {
+        if !(v.is_finite() && v >= lo && v <= hi) {
+            return Err(bad(key, format!("{v} is out of range [{lo}, {hi}]")));
+        }
+        *target = v;
+    }
+    Ok(())
+}
+
+fn ranged_int<T: Copy + PartialOrd + std::fmt::Display>(
+    target: &mut T,
+    v: Option<T>,
+    key: &str,
+    lo: T,
+    hi: T,
+) -> Result<(), SceneError> {
+    if let Some(v) = v {
+        if v < lo || v > hi {
+            return Err(bad(key, format!("{v} is out of range [{lo}, {hi}]")));
+        }
+        *target = v;
+    }
+    Ok(())
+}
+
+/// Mechanism overrides by name: `(key, field, lo, hi)`; a macro keeps the list in one place.
+macro_rules! mech_fields {
+    ($raw:expr, $m:expr, $( $f:ident : $lo:expr, $hi:expr );* $(;)?) => {
+        $( ranged(&mut $m.$f, $raw.$f, concat!("mechanism.", stringify!($f)), $lo, $hi)?; )*
+    };
+}
+
+impl RawFile {
+    fn into_scene(self, name: &str) -> Result<Scene, SceneError> {
+        let kind = SceneKind::parse(&self.scene.kind).ok_or_else(|| {
+            bad(
+                "scene.kind",
+                format!(
+                    "`{}` is not one of reverse_load, forward_load, continuous_closing, hold, drive",
+                    self.scene.kind
+                ),
+            )
+        })?;
+        let reading = match &self.scene.reading {
+            None => Reading::Physical,
+            Some(r) => Reading::parse(r)
+                .ok_or_else(|| bad("scene.reading", format!("`{r}` is not paper or physical")))?,
+        };
+        let mut s = Scene::builtin(kind, reading);
+        s.name = name.to_string();
+        ranged(
+            &mut s.load_torque_nm,
+            self.scene.load_torque_nm,
+            "scene.load_torque_nm",
+            0.0,
+            500.0,
+        )?;
+        ranged(
+            &mut s.initial_speed_rad_s,
+            self.scene.initial_speed_rad_s,
+            "scene.initial_speed_rad_s",
+            0.0,
+            200.0,
+        )?;
+        ranged(
+            &mut s.duration_s,
+            self.scene.duration_s,
+            "scene.duration_s",
+            1e-3,
+            60.0,
+        )?;
+        ranged(
+            &mut s.tolerance,
+            self.scene.tolerance,
+            "scene.tolerance",
+            1e-10,
+            1e-2,
+        )?;
+        if let Some(r) = self.scene.release_at_s {
+            if !(r.is_finite() && r >= 0.0 && r <= s.duration_s) {
+                return Err(bad(
+                    "scene.release_at_s",
+                    format!("{r} is out of range [0, duration_s = {}]", s.duration_s),
+                ));
+            }
+            if kind == SceneKind::Hold {
+                return Err(bad(
+                    "scene.release_at_s",
+                    "a hold scene has no drive to cut".into(),
+                ));
+            }
+            s.release_at_s = Some(r);
+        } else if s.release_at_s.is_some_and(|r| r > s.duration_s) {
+            s.release_at_s = None;
+        }
+        let raw = self.mechanism;
+        let m = &mut s.mechanism;
+        mech_fields!(raw, m,
+            output_shaft_mass_kg: 1e-6, 1e3;
+            input_shaft_mass_kg: 1e-6, 1e3;
+            ball_mass_kg: 1e-7, 10.0;
+            connecting_shaft_mass_kg: 1e-6, 1e3;
+            output_inertia_kg_m2: 1e-9, 1e3;
+            input_inertia_kg_m2: 1e-9, 1e3;
+            connecting_inertia_kg_m2: 1e-9, 1e3;
+            ball_inertia_kg_m2: 1e-12, 1.0;
+            spring_stiffness_n_m: 0.0, 1e9;
+            contact_stiffness: 1e3, 1e13;
+            spring_preload_m: 0.0, 0.1;
+            socket_radius_m: 1e-4, 1.0;
+            output_friction_radius_m: 0.0, 1.0;
+            connecting_friction_radius_m: 0.0, 1.0;
+            input_friction_radius_m: 0.0, 1.0;
+            pack_inner_radius_m: 0.0, 1.0;
+            pack_outer_radius_m: 1e-4, 1.0;
+            socket_clearance_m: 0.0, 0.01;
+            pack_clearance_m: 0.0, 0.05;
+            socket_chamfer_rad: 0.05, 1.52;
+            mu_static: 0.0, 2.0;
+            mu_dynamic: 0.0, 2.0;
+            restitution: 0.01, 1.0;
+            groove_angle_rad: 0.0, 6.0;
+        );
+        ranged_int(
+            &mut m.friction_discs,
+            raw.friction_discs,
+            "mechanism.friction_discs",
+            1,
+            20,
+        )?;
+        if m.pack_inner_radius_m >= m.pack_outer_radius_m {
+            return Err(bad(
+                "mechanism.pack_inner_radius_m",
+                "must be smaller than pack_outer_radius_m".into(),
+            ));
+        }
+        let rs = self.sensors;
+        let se = &mut s.sensors;
+        ranged(
+            &mut se.motor_torque_constant_nm_a,
+            rs.motor_torque_constant_nm_a,
+            "sensors.motor_torque_constant_nm_a",
+            1e-4,
+            10.0,
+        )?;
+        ranged(
+            &mut se.reducer_ratio,
+            rs.reducer_ratio,
+            "sensors.reducer_ratio",
+            1.0,
+            1e4,
+        )?;
+        ranged(
+            &mut se.reducer_efficiency,
+            rs.reducer_efficiency,
+            "sensors.reducer_efficiency",
+            0.01,
+            1.0,
+        )?;
+        ranged(
+            &mut se.current_full_scale_a,
+            rs.current_full_scale_a,
+            "sensors.current_full_scale_a",
+            0.01,
+            1e4,
+        )?;
+        ranged_int(
+            &mut se.current_adc_bits,
+            rs.current_adc_bits,
+            "sensors.current_adc_bits",
+            4,
+            16,
+        )?;
+        ranged_int(
+            &mut se.motor_encoder_counts_per_rev,
+            rs.motor_encoder_counts_per_rev,
+            "sensors.motor_encoder_counts_per_rev",
+            4,
+            1 << 24,
+        )?;
+        ranged_int(
+            &mut se.output_encoder_bits,
+            rs.output_encoder_bits,
+            "sensors.output_encoder_bits",
+            4,
+            24,
+        )?;
+        ranged_int(
+            &mut se.motor_counter_bits,
+            rs.motor_counter_bits,
+            "sensors.motor_counter_bits",
+            8,
+            32,
+        )?;
+        if let Some(seed) = rs.noise_seed {
+            s.noise.seed = seed;
+        }
+        ranged(
+            &mut s.noise.current_noise_a,
+            rs.current_noise_a,
+            "sensors.current_noise_a",
+            0.0,
+            100.0,
+        )?;
+        let ro = self.open;
+        let o = &mut s.open;
+        ranged(
+            &mut o.approach_speed_floor_m_s,
+            ro.approach_speed_floor_m_s,
+            "open.approach_speed_floor_m_s",
+            1e-6,
+            100.0,
+        )?;
+        ranged(
+            &mut o.drive_gain_nm_s_rad,
+            ro.drive_gain_nm_s_rad,
+            "open.drive_gain_nm_s_rad",
+            1e-3,
+            1e5,
+        )?;
+        ranged(
+            &mut o.reflected_motor_inertia_kg_m2,
+            ro.reflected_motor_inertia_kg_m2,
+            "open.reflected_motor_inertia_kg_m2",
+            0.0,
+            10.0,
+        )?;
+        ranged(
+            &mut o.bearing_smoothing_rad_s,
+            ro.bearing_smoothing_rad_s,
+            "open.bearing_smoothing_rad_s",
+            1e-6,
+            10.0,
+        )?;
+        ranged(
+            &mut o.axial_smoothing_m_s,
+            ro.axial_smoothing_m_s,
+            "open.axial_smoothing_m_s",
+            1e-9,
+            1.0,
+        )?;
+        ranged(
+            &mut o.shaft_gap_m,
+            ro.shaft_gap_m,
+            "open.shaft_gap_m",
+            0.0,
+            0.01,
+        )?;
+        ranged(
+            &mut o.stop_threshold_rad_s,
+            ro.stop_threshold_rad_s,
+            "open.stop_threshold_rad_s",
+            1e-6,
+            10.0,
+        )?;
+        if let Some(b) = ro.paper_far_face_stop {
+            o.paper_far_face_stop = b;
+        }
+        for (i, f) in self.fault.iter().enumerate() {
+            let kind = FaultKind::parse(&f.kind).ok_or_else(|| {
+                bad(
+                    &format!("fault[{i}].kind"),
+                    format!(
+                        "`{}` is not one of friction_loss, spring_broken, pack_wear, ramp_jam, drag, encoder_stuck, encoder_jump, current_open",
+                        f.kind
+                    ),
+                )
+            })?;
+            let mut at_s = 0.0;
+            ranged(
+                &mut at_s,
+                Some(f.at_s),
+                &format!("fault[{i}].at_s"),
+                0.0,
+                s.duration_s,
+            )?;
+            let mut severity = 0.0;
+            ranged(
+                &mut severity,
+                Some(f.severity),
+                &format!("fault[{i}].severity"),
+                0.0,
+                1.0,
+            )?;
+            s.faults.push(Fault {
+                kind,
+                at_s,
+                severity,
+            });
+        }
+        Ok(s)
+    }
+}

@@ -1,0 +1,859 @@
+//! `cargo xtask bench [--quick] [--json]` — speed against accuracy (issue 6).
+//!
+//! 1. The twin's `paper` reading at its tightest tolerance is the reference of the reduced model
+//!    (`noback::reduced`): the reduced model is that reading's quasi-static physics at a fixed
+//!    step, so this isolates the error of format, integrator and rate.
+//! 2. Every format × integrator × rate of the reduced model on `reverse_load` and
+//!    `forward_load`: output-angle and speed RMS, pressing-force RMS (% of the loaded force),
+//!    braking-torque RMS, lock-time error; host ns per step (median of repeated timed runs,
+//!    `std::time::Instant`, not criterion); Cortex-M3 instructions per step under QEMU
+//!    (`noback-bench`, `-icount shift=10`), and per simulated second.
+//! 3. The twin itself at several tolerances, both readings, against its tightest run.
+//! 4. The full physical model (`TwinModel::rhs`) with explicit Euler and RK4 at fixed steps from
+//!    0.5 µs up past their stability limit, for several contact stiffnesses: stable, diverged or
+//!    inaccurate (`bench/explicit.rs`).
+//! 5. The shipped monitor's cost (`cargo xtask run`'s replay on the M3).
+//!
+//! Writes `docs/results/speed-accuracy.csv` and `.svg`, `docs/results/stability.csv` and
+//! `.svg`, `docs/results/cheapest-per-scene.md`.
+
+pub mod explicit;
+
+use crate::cores::Core;
+use crate::qemu::{self, Boot};
+use crate::shell::{self, cargo, workspace_root};
+use explicit::{Explicit, Verdict};
+use fixed::types::{I16F16, I32F32};
+use noback::mechanism::TABLE2;
+use noback::reduced::num::{Real, Widen};
+use noback::reduced::{BrakingScene, Method, Params, Reduced};
+use noback_twin::model::physical::Physical;
+use noback_twin::model::Sample;
+use noback_twin::reading::Reading;
+use noback_twin::scene::{Scene, SceneKind};
+use noback_twin::sim::{model_config, run, run_model};
+use std::fmt::Write as _;
+use std::time::Instant;
+
+/// Rates of the reduced model (Hz).
+pub const RATES: [u32; 6] = [1_000, 2_000, 5_000, 10_000, 20_000, 50_000];
+/// Tightest tolerance of the twin: the reference.
+pub const REF_TOL: f64 = 1e-10;
+/// Speed below which the output counts as stopped (the twin's metric threshold).
+const STOP_RAD_S: f64 = 0.05;
+/// The monitor's accuracy targets a variant must meet (docs/monitor-design.md: speed within
+/// 0.5 rad/s, holding torque within 5 %; lock seen within ~9 ms there, 10 ms here).
+pub const TARGET_SPEED_RMS: f64 = 0.5;
+/// Pressing-force RMS target (% of the loaded force).
+pub const TARGET_FORCE_PCT: f64 = 5.0;
+/// Lock-time target (s).
+pub const TARGET_LOCK_S: f64 = 0.01;
+/// Holding-torque target (relative).
+pub const TARGET_HOLD_REL: f64 = 0.05;
+
+/// The formats measured, by name.
+pub const FORMATS: [&str; 5] = ["f64", "f32", "I16F16", "I32F32", "I16F16+I32F32"];
+
+/// Errors of one reduced run against the reference.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct Errors {
+    /// Output-angle RMS (rad).
+    pub angle_rms: f64,
+    /// Output-speed RMS (rad/s).
+    pub speed_rms: f64,
+    /// Pressing-force RMS (% of the loaded quasi-static force).
+    pub force_rms_pct: f64,
+    /// Braking-torque RMS (N·m).
+    pub torque_rms: f64,
+    /// |lock time − reference lock time| (s); 1.0 if either never locks.
+    pub lock_err_s: f64,
+    /// Holding torque at the end relative error.
+    pub hold_rel: f64,
+}
+
+impl Errors {
+    /// Meets the monitor's accuracy targets.
+    pub fn meets_targets(&self) -> bool {
+        self.speed_rms <= TARGET_SPEED_RMS
+            && self.force_rms_pct <= TARGET_FORCE_PCT
+            && self.lock_err_s <= TARGET_LOCK_S
+            && self.hold_rel <= TARGET_HOLD_REL
+    }
+}
+
+/// One recorded instant: (t, angle, speed, force, torque).
+type Row = (f64, f64, f64, f64, f64);
+
+/// Runs a reduced variant on a braking scene for `duration_s`, recording every
+/// `max(1/rate, 1e-4)` s.
+pub fn run_reduced<N: Real + Widen<A>, A: Real>(
+    method: Method,
+    scene: BrakingScene,
+    rate: u32,
+    duration_s: f64,
+) -> Vec<Row> {
+    let p = Params::from_mechanism(&TABLE2, TABLE2.load_torque_nm, f64::from(rate));
+    let mut m = Reduced::<N, A>::new(p, method);
+    m.set_drive(true, scene.speed_ref_rad_s);
+    let cut = scene.release_tick(rate);
+    let steps = (duration_s * f64::from(rate)).round() as u32;
+    let every = (rate / 10_000).max(1);
+    let mut rows = Vec::with_capacity(steps as usize / every as usize + 1);
+    let rec = |m: &Reduced<N, A>, t: f64, rows: &mut Vec<Row>| {
+        let o = m.output();
+        rows.push((
+            t,
+            m.state.theta.to_f64(),
+            m.state.omega.to_f64(),
+            o.pressing_n.to_f64(),
+            o.braking_nm.to_f64(),
+        ));
+    };
+    rec(&m, 0.0, &mut rows);
+    for k in 0..steps {
+        if k == cut {
+            m.set_drive(false, 0.0);
+        }
+        m.step();
+        if (k + 1) % every == 0 {
+            rec(&m, f64::from(k + 1) / f64::from(rate), &mut rows);
+        }
+    }
+    rows
+}
+
+fn run_reduced_by_name(
+    fmt: &str,
+    method: Method,
+    scene: BrakingScene,
+    rate: u32,
+    dur: f64,
+) -> Vec<Row> {
+    match fmt {
+        "f64" => run_reduced::<f64, f64>(method, scene, rate, dur),
+        "f32" => run_reduced::<f32, f32>(method, scene, rate, dur),
+        "I16F16" => run_reduced::<I16F16, I16F16>(method, scene, rate, dur),
+        "I32F32" => run_reduced::<I32F32, I32F32>(method, scene, rate, dur),
+        _ => run_reduced::<I16F16, I32F32>(method, scene, rate, dur),
+    }
+}
+
+/// Host nanoseconds per step: the median over `reps` timed runs of 10 000 steps.
+fn host_ns_per_step(fmt: &str, method: Method, reps: usize) -> f64 {
+    fn time<N: Real + Widen<A>, A: Real>(method: Method) -> f64 {
+        let p = Params::from_mechanism(&TABLE2, TABLE2.load_torque_nm, 10_000.0);
+        let mut m = Reduced::<N, A>::new(p, method);
+        m.set_drive(true, BrakingScene::REVERSE.speed_ref_rad_s);
+        m.step();
+        m.set_drive(false, 0.0);
+        let start = Instant::now();
+        for _ in 0..10_000 {
+            m.step();
+            std::hint::black_box(&m);
+        }
+        start.elapsed().as_nanos() as f64 / 1e4
+    }
+    let mut v: Vec<f64> = (0..reps)
+        .map(|_| match fmt {
+            "f64" => time::<f64, f64>(method),
+            "f32" => time::<f32, f32>(method),
+            "I16F16" => time::<I16F16, I16F16>(method),
+            "I32F32" => time::<I32F32, I32F32>(method),
+            _ => time::<I16F16, I32F32>(method),
+        })
+        .collect();
+    v.sort_by(f64::total_cmp);
+    v.get(v.len() / 2).copied().unwrap_or(f64::NAN)
+}
+
+/// Lock time after `release` (s): the first recorded instant after the last one at or above
+/// the stop threshold; `None` if still moving at the end.
+pub fn lock_time(rows: &[(f64, f64)], release: f64) -> Option<f64> {
+    let after: Vec<&(f64, f64)> = rows.iter().filter(|r| r.0 >= release - 1e-12).collect();
+    match after.iter().rposition(|r| r.1.abs() >= STOP_RAD_S) {
+        None => Some(0.0),
+        Some(i) => after.get(i + 1).map(|r| r.0 - release),
+    }
+}
+
+/// The reference samples of a scene (paper reading, tightest tolerance).
+pub fn reference(kind: SceneKind, reading: Reading, tol: f64) -> Result<Vec<Sample>, String> {
+    let mut scene = Scene::builtin(kind, reading);
+    scene.tolerance = tol;
+    run(&scene)
+        .map(|r| r.samples)
+        .map_err(|e| format!("twin {kind:?} at tol {tol}: {e:?}"))
+}
+
+/// Errors of reduced rows against reference samples at 10 kHz (t = i·1e-4).
+pub fn errors(rows: &[Row], reference: &[Sample], release: f64) -> Errors {
+    let f_loaded = TABLE2.quasi_static_pressing_force_n(TABLE2.load_torque_nm);
+    let (mut a, mut w, mut f, mut tq, mut n) = (0.0, 0.0, 0.0, 0.0, 0.0);
+    let mut ref_rows = Vec::new();
+    for r in rows {
+        let i = (r.0 * 1e4).round() as usize;
+        let Some(s) = reference.get(i) else { continue };
+        a += (r.1 - s.output_angle_rad).powi(2);
+        w += (r.2 - s.output_speed_rad_s).powi(2);
+        f += (r.3 - s.pressing_force_n).powi(2);
+        tq += (r.4 - s.braking_torque_nm).powi(2);
+        n += 1.0;
+        ref_rows.push((s.t_s, s.output_speed_rad_s));
+    }
+    let n = f64::max(n, 1.0);
+    let mine: Vec<(f64, f64)> = rows.iter().map(|r| (r.0, r.2)).collect();
+    let lock_err_s = match (lock_time(&mine, release), lock_time(&ref_rows, release)) {
+        (Some(x), Some(y)) => (x - y).abs(),
+        _ => 1.0,
+    };
+    let hold = rows.last().map_or(0.0, |r| r.4);
+    Errors {
+        angle_rms: (a / n).sqrt(),
+        speed_rms: (w / n).sqrt(),
+        force_rms_pct: 100.0 * (f / n).sqrt() / f_loaded,
+        torque_rms: (tq / n).sqrt(),
+        lock_err_s,
+        hold_rel: (hold - TABLE2.load_torque_nm).abs() / TABLE2.load_torque_nm,
+    }
+}
+
+/// One row of the speed-accuracy table.
+#[derive(Clone, Debug)]
+struct Variant {
+    family: String,
+    format: String,
+    method: String,
+    rate_hz: f64,
+    scene: &'static str,
+    e: Errors,
+    m3_insns_per_step: Option<f64>,
+    host_ns_per_step: f64,
+    rhs_evals: f64,
+}
+
+impl Variant {
+    fn m3_per_s(&self) -> Option<f64> {
+        self.m3_insns_per_step.map(|i| i * self.rate_hz)
+    }
+    fn label(&self) -> String {
+        format!(
+            "{} {} {} {}",
+            self.family,
+            self.format,
+            self.method,
+            if self.rate_hz > 0.0 {
+                format!("{} kHz", self.rate_hz / 1e3)
+            } else {
+                String::new()
+            }
+        )
+    }
+}
+
+/// M3 instructions per step of every format × integrator, from `noback-bench` under QEMU.
+fn m3_costs(echo: bool) -> Result<Vec<(String, String, f64, f64)>, String> {
+    let core = Core::M3;
+    shell::run(cargo().args([
+        "build",
+        "--release",
+        "-p",
+        "noback",
+        "--bin",
+        "noback-bench",
+        "--target",
+        core.triple(),
+    ]))?;
+    let elf = workspace_root()
+        .join("target")
+        .join(core.triple())
+        .join("release")
+        .join("noback-bench");
+    let elf = elf.to_string_lossy().into_owned();
+    let shift = crate::run::BENCH_SHIFT;
+    let out = qemu::boot(&Boot {
+        elf: &elf,
+        core,
+        timeout: crate::test::BOOT_TIMEOUT,
+        extra: qemu::icount(shift),
+        echo,
+        args: Vec::new(),
+    })?;
+    if out.code != 0 {
+        return Err(format!("noback-bench exited with code {}", out.code));
+    }
+    let per = core.ticks_per_insn(shift);
+    let mut v = Vec::new();
+    for line in out
+        .lines
+        .iter()
+        .filter(|l| l.split_whitespace().nth(1) == Some("variant"))
+    {
+        let f = crate::run::fields(line);
+        let get = |k: &str| f.get(k).copied().unwrap_or("");
+        let steps: f64 = get("steps").parse().map_err(|_| "bad steps")?;
+        let sum: f64 = get("ticks_sum").parse().map_err(|_| "bad ticks_sum")?;
+        let max: f64 = get("ticks_max").parse().map_err(|_| "bad ticks_max")?;
+        v.push((
+            get("fmt").to_string(),
+            get("method").to_string(),
+            sum / steps.max(1.0) / per,
+            max / per,
+        ));
+    }
+    if !out.lines.iter().any(|l| l.contains("bench-done")) {
+        return Err("noback-bench did not finish".into());
+    }
+    Ok(v)
+}
+
+/// Stability-map row.
+#[derive(Clone, Debug)]
+struct StabRow {
+    method: &'static str,
+    stiffness_scale: f64,
+    h_us: f64,
+    verdict: &'static str,
+    diverged_at_s: Option<f64>,
+    speed_rms: Option<f64>,
+    rhs_evals: u64,
+}
+
+/// Threshold of "inaccurate" for the explicit runs: output-speed RMS against the twin (rad/s).
+pub const STAB_INACCURATE_RAD_S: f64 = 0.1;
+
+fn stability(quick: bool) -> Result<Vec<StabRow>, String> {
+    let window = if quick { 0.01 } else { 0.03 };
+    let steps_us: &[f64] = if quick {
+        &[0.5, 1.0, 2.0, 2.5, 4.0, 5.0, 10.0]
+    } else {
+        &[0.5, 1.0, 2.0, 2.5, 4.0, 5.0, 10.0, 20.0]
+    };
+    let stiff: &[f64] = if quick { &[1.0] } else { &[0.25, 1.0, 4.0] };
+    let mut rows = Vec::new();
+    for &ks in stiff {
+        let mut scene = Scene::builtin(SceneKind::ReverseLoad, Reading::Physical);
+        scene.mechanism.contact_stiffness *= ks;
+        scene.duration_s = window;
+        scene.tolerance = 1e-8;
+        let reference = run_model(&scene, Physical::new(model_config(&scene)))
+            .map_err(|e| format!("twin reference: {e:?}"))?
+            .samples;
+        for method in [Explicit::Euler, Explicit::Rk4] {
+            for &h in steps_us {
+                let mut model = Physical::new(model_config(&scene));
+                let r = explicit::integrate(&mut model, method, h * 1e-6, window, 1e-4);
+                let (verdict, at, rms) = match r.verdict {
+                    Verdict::Diverged { at_s } => ("diverged", Some(at_s), None),
+                    Verdict::Finished => {
+                        let (mut s, mut n) = (0.0, 0.0);
+                        for (t, _, w) in &r.samples {
+                            if let Some(x) = reference.get((t * 1e4).round() as usize) {
+                                s += (w - x.output_speed_rad_s).powi(2);
+                                n += 1.0;
+                            }
+                        }
+                        let rms = (s / f64::max(n, 1.0)).sqrt();
+                        (
+                            if rms > STAB_INACCURATE_RAD_S {
+                                "inaccurate"
+                            } else {
+                                "stable"
+                            },
+                            None,
+                            Some(rms),
+                        )
+                    }
+                };
+                eprintln!(
+                    "bench: stability {} k×{ks} h={h} µs: {verdict}",
+                    method.name()
+                );
+                rows.push(StabRow {
+                    method: method.name(),
+                    stiffness_scale: ks,
+                    h_us: h,
+                    verdict,
+                    diverged_at_s: at,
+                    speed_rms: rms,
+                    rhs_evals: r.rhs_evals,
+                });
+            }
+        }
+    }
+    Ok(rows)
+}
+
+fn opt(v: Option<f64>) -> String {
+    v.map_or(String::new(), |x| format!("{x:.6e}"))
+}
+
+/// Indices of the Pareto-optimal points (lower cost and lower error both better).
+fn pareto(points: &[(f64, f64)]) -> Vec<usize> {
+    let mut idx: Vec<usize> = (0..points.len()).collect();
+    idx.sort_by(|&a, &b| {
+        let (pa, pb) = (points.get(a), points.get(b));
+        pa.map(|p| p.0)
+            .unwrap_or(f64::MAX)
+            .total_cmp(&pb.map(|p| p.0).unwrap_or(f64::MAX))
+    });
+    let mut best = f64::INFINITY;
+    let mut front = Vec::new();
+    for i in idx {
+        if let Some(&(_, e)) = points.get(i) {
+            if e < best {
+                best = e;
+                front.push(i);
+            }
+        }
+    }
+    front
+}
+
+fn chart(
+    path: &std::path::Path,
+    pts: &[(f64, f64, String)],
+    front: &[usize],
+    shipped_per_s: f64,
+) -> Result<(), String> {
+    use plotters::prelude::*;
+    let e = |x: DrawingAreaErrorKind<_>| format!("chart: {x:?}");
+    let root = SVGBackend::new(path, (960, 640)).into_drawing_area();
+    root.fill(&WHITE).map_err(e)?;
+    let (mut x0, mut x1, mut y0, mut y1) = (f64::MAX, 0.0_f64, f64::MAX, 0.0_f64);
+    for (x, y, _) in pts {
+        x0 = x0.min(*x);
+        x1 = x1.max(*x);
+        y0 = y0.min(*y);
+        y1 = y1.max(*y);
+    }
+    x0 = x0.min(shipped_per_s) * 0.7;
+    x1 = x1.max(shipped_per_s) * 1.4;
+    y0 = y0.max(1e-9) * 0.5;
+    y1 *= 2.0;
+    let mut c = ChartBuilder::on(&root)
+        .caption(
+            "reverse_load: output-angle RMS error vs Cortex-M3 instructions per simulated second",
+            ("sans-serif", 18),
+        )
+        .margin(12)
+        .x_label_area_size(40)
+        .y_label_area_size(70)
+        .build_cartesian_2d((x0..x1).log_scale(), (y0..y1).log_scale())
+        .map_err(e)?;
+    c.configure_mesh()
+        .x_desc("M3 instructions per simulated second (QEMU -icount)")
+        .y_desc("angle RMS error (rad) vs twin paper reading, tol 1e-10")
+        .draw()
+        .map_err(e)?;
+    c.draw_series(
+        pts.iter()
+            .map(|(x, y, _)| Circle::new((*x, *y), 3, BLUE.mix(0.5).filled())),
+    )
+    .map_err(e)?;
+    let line: Vec<(f64, f64)> = front
+        .iter()
+        .filter_map(|&i| pts.get(i).map(|p| (p.0, p.1)))
+        .collect();
+    c.draw_series(LineSeries::new(line.clone(), RED.stroke_width(2)))
+        .map_err(e)?
+        .label("Pareto frontier")
+        .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], RED));
+    for (i, &(x, y)) in line.iter().enumerate() {
+        if let Some(p) = front.get(i).and_then(|&k| pts.get(k)) {
+            c.draw_series(std::iter::once(Text::new(
+                p.2.clone(),
+                (x, y),
+                ("sans-serif", 10),
+            )))
+            .map_err(e)?;
+        }
+    }
+    c.draw_series(LineSeries::new(
+        vec![(shipped_per_s, y0), (shipped_per_s, y1)],
+        GREEN.stroke_width(2),
+    ))
+    .map_err(e)?
+    .label("shipped monitor step cost (whole estimator, M3)")
+    .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], GREEN));
+    c.configure_series_labels()
+        .background_style(WHITE.mix(0.8))
+        .border_style(BLACK)
+        .draw()
+        .map_err(e)?;
+    root.present().map_err(e)?;
+    Ok(())
+}
+
+fn stability_chart(path: &std::path::Path, rows: &[StabRow]) -> Result<(), String> {
+    use plotters::prelude::*;
+    let e = |x: DrawingAreaErrorKind<_>| format!("chart: {x:?}");
+    let root = SVGBackend::new(path, (800, 420)).into_drawing_area();
+    root.fill(&WHITE).map_err(e)?;
+    let mut c = ChartBuilder::on(&root)
+        .caption(
+            "full physical model, fixed explicit steps: green stable, orange inaccurate, red diverged",
+            ("sans-serif", 16),
+        )
+        .margin(12)
+        .x_label_area_size(40)
+        .y_label_area_size(90)
+        .build_cartesian_2d((0.3_f64..40.0).log_scale(), 0.0_f64..7.0)
+        .map_err(e)?;
+    c.configure_mesh()
+        .x_desc("step (µs)")
+        .y_desc("method, contact stiffness ×")
+        .y_labels(0)
+        .draw()
+        .map_err(e)?;
+    let mut lanes: Vec<(&str, f64)> = Vec::new();
+    for r in rows {
+        if !lanes.contains(&(r.method, r.stiffness_scale)) {
+            lanes.push((r.method, r.stiffness_scale));
+        }
+    }
+    for (li, lane) in lanes.iter().enumerate() {
+        let y = li as f64 + 0.5;
+        c.draw_series(std::iter::once(Text::new(
+            format!("{} k×{}", lane.0, lane.1),
+            (0.32, y + 0.2),
+            ("sans-serif", 12),
+        )))
+        .map_err(e)?;
+        for r in rows
+            .iter()
+            .filter(|r| (r.method, r.stiffness_scale) == *lane)
+        {
+            let col = match r.verdict {
+                "stable" => GREEN,
+                "inaccurate" => RGBColor(255, 140, 0),
+                _ => RED,
+            };
+            c.draw_series(std::iter::once(Circle::new((r.h_us, y), 7, col.filled())))
+                .map_err(e)?;
+        }
+    }
+    root.present().map_err(e)?;
+    Ok(())
+}
+
+/// Entry.
+pub fn main(args: &[String]) -> Result<i32, String> {
+    let mut quick = false;
+    let mut json = false;
+    for a in args {
+        match a.as_str() {
+            "--quick" => quick = true,
+            "--json" => json = true,
+            other => {
+                return Err(format!(
+                    "unknown argument `{other}` (bench [--quick] [--json])"
+                ))
+            }
+        }
+    }
+    let t0 = Instant::now();
+    crate::bootstrap::ensure_all()?;
+    let reps = if quick { 3 } else { 11 };
+    let scenes = [
+        (
+            "reverse_load",
+            SceneKind::ReverseLoad,
+            BrakingScene::REVERSE,
+        ),
+        (
+            "forward_load",
+            SceneKind::ForwardLoad,
+            BrakingScene::FORWARD,
+        ),
+    ];
+
+    eprintln!("bench: M3 instruction counts under QEMU (noback-bench)");
+    let m3 = m3_costs(false)?;
+    let m3_of = |f: &str, m: &str| m3.iter().find(|(a, b, _, _)| a == f && b == m).map(|x| x.2);
+    eprintln!("bench: the shipped monitor (cargo xtask run's replay, M3)");
+    let (shipped, _) = crate::run::replay_report("reverse_load", Core::M3, None, None, false)?;
+    let shipped_insns = shipped["insns_per_step_mean"].as_f64().unwrap_or(f64::NAN);
+
+    let mut variants: Vec<Variant> = Vec::new();
+    // Twin at several tolerances, both readings, against its tightest run.
+    let tols: &[f64] = if quick {
+        &[1e-3, 1e-5, 1e-7]
+    } else {
+        &[1e-2, 1e-3, 1e-4, 1e-5, 1e-6, 1e-7, 1e-8]
+    };
+    let mut refs = Vec::new();
+    for (name, kind, bs) in scenes {
+        for reading in [Reading::Paper, Reading::Physical] {
+            let ref_tol = if reading == Reading::Paper {
+                REF_TOL
+            } else {
+                1e-9
+            };
+            eprintln!(
+                "bench: twin {name} ({}) reference at tol {ref_tol}",
+                reading.name()
+            );
+            let reference = reference(kind, reading, ref_tol)?;
+            for &tol in tols {
+                let mut scene = Scene::builtin(kind, reading);
+                scene.tolerance = tol;
+                let mut walls = Vec::new();
+                let mut last = None;
+                for _ in 0..reps.min(5) {
+                    let r = run(&scene).map_err(|e| format!("twin at {tol}: {e:?}"))?;
+                    walls.push(r.wall_s);
+                    last = Some(r);
+                }
+                walls.sort_by(f64::total_cmp);
+                let Some(r) = last else { continue };
+                let rows: Vec<Row> = r
+                    .samples
+                    .iter()
+                    .map(|s| {
+                        (
+                            s.t_s,
+                            s.output_angle_rad,
+                            s.output_speed_rad_s,
+                            s.pressing_force_n,
+                            s.braking_torque_nm,
+                        )
+                    })
+                    .collect();
+                let mut e = errors(&rows, &reference, bs.release_s);
+                e.hold_rel = 0.0;
+                variants.push(Variant {
+                    family: format!("twin-{}", reading.name()),
+                    format: "f64".into(),
+                    method: format!("rosenbrock tol={tol:e}"),
+                    rate_hz: 0.0,
+                    scene: name,
+                    e,
+                    m3_insns_per_step: None,
+                    host_ns_per_step: walls.get(walls.len() / 2).copied().unwrap_or(0.0) * 1e9
+                        / r.stats.steps.max(1) as f64,
+                    rhs_evals: r.stats.rhs_evals as f64,
+                });
+            }
+            if reading == Reading::Paper {
+                refs.push((name, bs, reference));
+            }
+        }
+    }
+    // The reduced model.
+    let total = FORMATS.len() * Method::ALL.len();
+    let mut done = 0;
+    for fmt in FORMATS {
+        for method in Method::ALL {
+            done += 1;
+            eprintln!("bench: reduced {fmt} {} ({done}/{total})", method.name());
+            let ns = host_ns_per_step(fmt, method, reps);
+            for (name, bs, reference) in &refs {
+                for rate in RATES {
+                    let rows = run_reduced_by_name(fmt, method, *bs, rate, 1.0);
+                    variants.push(Variant {
+                        family: "reduced".into(),
+                        format: fmt.into(),
+                        method: method.name().into(),
+                        rate_hz: f64::from(rate),
+                        scene: name,
+                        e: errors(&rows, reference, bs.release_s),
+                        m3_insns_per_step: m3_of(fmt, method.name()),
+                        host_ns_per_step: ns,
+                        rhs_evals: f64::from(method.rhs_per_step()) * f64::from(rate),
+                    });
+                }
+            }
+        }
+    }
+    eprintln!("bench: stability of explicit steps on the full physical model");
+    let stab = stability(quick)?;
+
+    // Outputs.
+    let dir = workspace_root().join("docs").join("results");
+    std::fs::create_dir_all(&dir).map_err(|e| e.to_string())?;
+    let mut csv = String::from("family,format,method,rate_hz,scene,angle_rms_rad,speed_rms_rad_s,force_rms_pct,torque_rms_nm,lock_err_s,hold_rel,meets_targets,m3_insns_per_step,m3_insns_per_s,host_ns_per_step,rhs_evals_per_s\n");
+    for v in &variants {
+        let _ = writeln!(
+            csv,
+            "{},{},{},{},{},{:.6e},{:.6e},{:.4},{:.6e},{:.5},{:.5},{},{},{},{:.1},{}",
+            v.family,
+            v.format,
+            v.method,
+            v.rate_hz,
+            v.scene,
+            v.e.angle_rms,
+            v.e.speed_rms,
+            v.e.force_rms_pct,
+            v.e.torque_rms,
+            v.e.lock_err_s,
+            v.e.hold_rel,
+            v.e.meets_targets(),
+            opt(v.m3_insns_per_step),
+            opt(v.m3_per_s()),
+            v.host_ns_per_step,
+            v.rhs_evals
+        );
+    }
+    let _ = writeln!(
+        csv,
+        "shipped-monitor,I16F16+Scale+u32 angle,observer,10000,reverse_load,,,,,,,,{shipped_insns:.1},{:.6e},,",
+        shipped_insns * 1e4
+    );
+    std::fs::write(dir.join("speed-accuracy.csv"), &csv).map_err(|e| e.to_string())?;
+
+    let mut scsv = String::from(
+        "method,contact_stiffness_scale,step_us,verdict,diverged_at_s,speed_rms_rad_s,rhs_evals\n",
+    );
+    for r in &stab {
+        let _ = writeln!(
+            scsv,
+            "{},{},{},{},{},{},{}",
+            r.method,
+            r.stiffness_scale,
+            r.h_us,
+            r.verdict,
+            opt(r.diverged_at_s),
+            opt(r.speed_rms),
+            r.rhs_evals
+        );
+    }
+    std::fs::write(dir.join("stability.csv"), &scsv).map_err(|e| e.to_string())?;
+    stability_chart(&dir.join("stability.svg"), &stab)?;
+
+    // Chart and Pareto front: reduced variants on reverse_load.
+    let rev: Vec<&Variant> = variants
+        .iter()
+        .filter(|v| v.family == "reduced" && v.scene == "reverse_load")
+        .collect();
+    let pts: Vec<(f64, f64, String)> = rev
+        .iter()
+        .filter_map(|v| {
+            v.m3_per_s()
+                .map(|c| (c, v.e.angle_rms.max(1e-9), v.label()))
+        })
+        .collect();
+    let front = pareto(&pts.iter().map(|p| (p.0, p.1)).collect::<Vec<(f64, f64)>>());
+    chart(
+        &dir.join("speed-accuracy.svg"),
+        &pts,
+        &front,
+        shipped_insns * 1e4,
+    )?;
+
+    // Cheapest per scene.
+    let mut md = String::from("# The cheapest model per scene\n\nWritten by `cargo xtask bench`. Cheapest = fewest Cortex-M3 instructions per simulated second among the reduced variants that meet the monitor's accuracy targets against the twin's `paper` reading at tolerance 1e-10: output-speed RMS ≤ 0.5 rad/s, pressing-force RMS ≤ 5 % of the loaded force, lock time within 10 ms, holding torque within 5 % (targets from docs/monitor-design.md).\n\n| scene | cheapest variant | M3 insns/step | M3 insns/s | angle RMS (rad) | speed RMS (rad/s) | force RMS % | lock error (ms) |\n|---|---|---|---|---|---|---|---|\n");
+    let mut cheapest_rows = Vec::new();
+    for (name, _, _) in scenes {
+        let best = variants
+            .iter()
+            .filter(|v| v.family == "reduced" && v.scene == name && v.e.meets_targets())
+            .min_by(|a, b| {
+                a.m3_per_s()
+                    .unwrap_or(f64::MAX)
+                    .total_cmp(&b.m3_per_s().unwrap_or(f64::MAX))
+            });
+        match best {
+            Some(v) => {
+                let _ = writeln!(
+                    md,
+                    "| {name} | {} | {:.0} | {:.3e} | {:.2e} | {:.3} | {:.3} | {:.1} |",
+                    v.label(),
+                    v.m3_insns_per_step.unwrap_or(f64::NAN),
+                    v.m3_per_s().unwrap_or(f64::NAN),
+                    v.e.angle_rms,
+                    v.e.speed_rms,
+                    v.e.force_rms_pct,
+                    v.e.lock_err_s * 1e3
+                );
+                cheapest_rows.push((name, v.label()));
+            }
+            None => {
+                let _ = writeln!(md, "| {name} | none meets the targets | | | | | | |");
+            }
+        }
+    }
+    md.push_str("| hold | not measured: at rest under the load every variant is exactly stuck (`T = M`), so the cheapest step at the lowest rate suffices; the bench does not run it |  |  |  |  |  |  |\n| drive | not measured: the driven output is kinematic in this reading |  |  |  |  |  |  |\n| continuous_closing | not covered: the reduced model has no drive-on engagement cycle; only the twin |  |  |  |  |  |  |\n");
+    let _ = writeln!(
+        md,
+        "\nThe shipped monitor (whole estimator: observer, model, flags) costs {shipped_insns:.1} M3 instructions per step at 10 kHz ({:.3e} per simulated second).",
+        shipped_insns * 1e4
+    );
+    std::fs::write(dir.join("cheapest-per-scene.md"), &md).map_err(|e| e.to_string())?;
+
+    if json {
+        let vs: Vec<_> = variants
+            .iter()
+            .map(|v| {
+                serde_json::json!({
+                    "family": v.family, "format": v.format, "method": v.method,
+                    "rate_hz": v.rate_hz, "scene": v.scene,
+                    "angle_rms_rad": v.e.angle_rms, "speed_rms_rad_s": v.e.speed_rms,
+                    "force_rms_pct": v.e.force_rms_pct, "torque_rms_nm": v.e.torque_rms,
+                    "lock_err_s": v.e.lock_err_s, "meets_targets": v.e.meets_targets(),
+                    "m3_insns_per_step": v.m3_insns_per_step, "host_ns_per_step": v.host_ns_per_step,
+                })
+            })
+            .collect();
+        let front_labels: Vec<&String> = front
+            .iter()
+            .filter_map(|&i| pts.get(i).map(|p| &p.2))
+            .collect();
+        println!(
+            "{}",
+            serde_json::json!({
+                "variants": vs, "pareto_reverse_load": front_labels,
+                "cheapest": cheapest_rows, "shipped_insns_per_step": shipped_insns,
+                "stability": stab.iter().map(|r| serde_json::json!({"method": r.method, "k_scale": r.stiffness_scale, "h_us": r.h_us, "verdict": r.verdict})).collect::<Vec<_>>(),
+                "seconds": t0.elapsed().as_secs_f64(),
+            })
+        );
+    } else {
+        println!("format         method      rate   scene         angle RMS  speed RMS  force%  lock ms  M3 insn/step  host ns  targets");
+        for v in variants.iter().filter(|v| v.family == "reduced") {
+            println!(
+                "{:<14} {:<11} {:>3}k  {:<12} {:>9.2e}  {:>9.2e}  {:>6.3}  {:>7.2}  {:>12.0}  {:>7.1}  {}",
+                v.format,
+                v.method,
+                v.rate_hz / 1e3,
+                v.scene,
+                v.e.angle_rms,
+                v.e.speed_rms,
+                v.e.force_rms_pct,
+                v.e.lock_err_s * 1e3,
+                v.m3_insns_per_step.unwrap_or(f64::NAN),
+                v.host_ns_per_step,
+                if v.e.meets_targets() { "yes" } else { "no" }
+            );
+        }
+        println!("\ntwin against its tightest run (paper 1e-10, physical 1e-9):");
+        for v in variants.iter().filter(|v| v.family != "reduced") {
+            println!(
+                "{:<15} {:<24} {:<12} angle RMS {:.2e}  speed RMS {:.2e}  lock err {:.2} ms  rhs evals {:.0}  host ns/step {:.0}",
+                v.family, v.method, v.scene, v.e.angle_rms, v.e.speed_rms, v.e.lock_err_s * 1e3, v.rhs_evals, v.host_ns_per_step
+            );
+        }
+        println!("\nPareto front (reverse_load, angle RMS vs M3 insns/s):");
+        for &i in &front {
+            if let Some(p) = pts.get(i) {
+                println!("  {:<40} {:.3e} insns/s  {:.2e} rad", p.2, p.0, p.1);
+            }
+        }
+        println!("\nstability (full physical model, explicit fixed steps):");
+        for r in &stab {
+            println!(
+                "  {:<5} k×{:<5} h={:>5} µs  {}",
+                r.method, r.stiffness_scale, r.h_us, r.verdict
+            );
+        }
+        println!("\ncheapest per scene:");
+        for (s, l) in &cheapest_rows {
+            println!("  {s}: {l}");
+        }
+        println!("shipped monitor: {shipped_insns:.1} M3 insns/step");
+        println!(
+            "\nwrote docs/results/speed-accuracy.{{csv,svg}}, stability.{{csv,svg}}, cheapest-per-scene.md in {:.0} s",
+            t0.elapsed().as_secs_f64()
+        );
+    }
+    Ok(0)
+}
