@@ -27,8 +27,12 @@ pub const LOCK_CONFIRM_S: f64 = 0.020;
 /// The twin's 10 kHz sensor trace of a scene (built-in name or TOML file), physical reading
 /// unless the file says otherwise.
 pub fn twin_trace(target: &str) -> Result<Trace, String> {
-    let scene = noback_twin::cli::load_scene(target, None)?;
-    let run = noback_twin::sim::run(&scene).map_err(|e| format!("twin: {e}"))?;
+    scene_trace(&noback_twin::cli::load_scene(target, None)?)
+}
+
+/// The twin's 10 kHz sensor trace of a scene built in code.
+pub fn scene_trace(scene: &noback_twin::scene::Scene) -> Result<Trace, String> {
+    let run = noback_twin::sim::run(scene).map_err(|e| format!("twin: {}: {e}", scene.name))?;
     Ok(noback_twin::sensing::trace(
         &run.samples,
         &scene.sensors,

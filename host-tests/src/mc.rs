@@ -11,7 +11,7 @@
 //! manifests ([`crate::accuracy::manifest_time`]). A nominal run with any flag is a false
 //! alarm. Runs are spread over the machine's cores.
 
-use crate::accuracy::{compare, detection_latency_s, manifest_time, run_monitor};
+use crate::accuracy::{compare, detection_latency_s, manifest_time, run_monitor, scene_trace};
 use noback::mechanism::Mechanism;
 use noback::monitor::Config;
 use noback_twin::fault::{Fault, FaultKind};
@@ -152,18 +152,11 @@ pub fn evaluate(d: &Draw) -> Outcome {
         false_flags: 0,
         error: Some(e),
     };
-    let run = match noback_twin::sim::run(&d.scene) {
-        Ok(run) => run,
-        Err(e) => return fail(format!("{}: twin: {e}", d.scene.name)),
+    let mut trace = match scene_trace(&d.scene) {
+        Ok(trace) => trace,
+        Err(e) => return fail(e),
     };
     let s = &d.scene.sensors;
-    let mut trace = noback_twin::sensing::trace(
-        &run.samples,
-        s,
-        &d.scene.noise,
-        &d.scene.faults,
-        noback_twin::sim::SAMPLE_RATE_HZ,
-    );
     if d.mirrored {
         mirror(
             &mut trace,

@@ -3,7 +3,7 @@
 //! off. The monitor must flag it (brake_slip or brake_weak), and must not when the pack is
 //! healthy. Traces come from the twin (physical reading).
 
-use host_tests::accuracy::{compare, run_monitor};
+use host_tests::accuracy::{compare, run_monitor, scene_trace};
 use noback::monitor::Config;
 use noback_twin::fault::{Fault, FaultKind};
 use noback_twin::reading::Reading;
@@ -12,14 +12,7 @@ use noback_twin::scene::{Scene, SceneKind};
 fn flags_after_power_on(fault: Option<Fault>) -> Vec<(&'static str, f64)> {
     let mut scene = Scene::builtin(SceneKind::Hold, Reading::Physical);
     scene.faults.extend(fault);
-    let run = noback_twin::sim::run(&scene).expect("twin");
-    let trace = noback_twin::sensing::trace(
-        &run.samples,
-        &scene.sensors,
-        &scene.noise,
-        &scene.faults,
-        noback_twin::sim::SAMPLE_RATE_HZ,
-    );
+    let trace = scene_trace(&scene).expect("twin");
     let acc = compare(
         &trace,
         &run_monitor(&trace, Config::default()).expect("monitor"),
