@@ -21,10 +21,21 @@ pub fn main(args: &[String]) -> Result<i32, String> {
         }
     }
     let mut cmd = cargo();
-    cmd.args(["run", "--quiet", "--release", "-p", "noback-twin", "--example", "bench", "--"])
-        .args(args);
+    cmd.args([
+        "run",
+        "--quiet",
+        "--release",
+        "-p",
+        "noback-twin",
+        "--example",
+        "bench",
+        "--",
+    ])
+    .args(args);
     eprintln!("$ {}", shell::describe(&cmd));
-    let out = cmd.output().map_err(|e| format!("starting the twin bench: {e}"))?;
+    let out = cmd
+        .output()
+        .map_err(|e| format!("starting the twin bench: {e}"))?;
     let table = String::from_utf8_lossy(&out.stdout);
     print!("{table}");
     if !out.status.success() {
@@ -37,7 +48,10 @@ pub fn main(args: &[String]) -> Result<i32, String> {
          from one run on the machine that wrote this page (a benchmark, not a test).\n\n{table}",
         args.join(" ")
     );
-    let path = workspace_root().join("docs").join("results").join("twin-speed.md");
+    let path = workspace_root()
+        .join("docs")
+        .join("results")
+        .join("twin-speed.md");
     std::fs::write(&path, doc).map_err(|e| format!("{}: {e}", path.display()))?;
     eprintln!("wrote {}", path.display());
     Ok(0)
