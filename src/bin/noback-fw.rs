@@ -243,7 +243,7 @@ mod target {
             let mut app = APP.borrow(cs).borrow_mut();
             let app = app.as_mut()?;
             let estimate = app.tick(n);
-            if reset_every != 0 && tick_no.wrapping_add(1) % reset_every == 0 {
+            if reset_every != 0 && tick_no.wrapping_add(1).is_multiple_of(reset_every) {
                 app.reset_flags();
             }
             estimate
