@@ -5,7 +5,7 @@
 /// Defines the probe's entry point on the target and a stub `main` on the host.
 #[macro_export]
 macro_rules! probe {
-    ($what:literal, $body:block) => {
+    ($what:literal, $body:expr) => {
         #[cfg(target_os = "none")]
         #[cortex_m_rt::entry]
         fn main() -> ! {
