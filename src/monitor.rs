@@ -17,22 +17,23 @@
 //! # Model
 //! Only the output shaft's rotation is dynamic: `J_s·ω̇ = M + u − T`, with `u` the drive torque
 //! from the motor current (`k_t·ratio·η`, `÷η` when back-driven), `M` the load and `T` the pack
-//! torque. The axial force balance is quasi-static: pressing force `F = F_spring` while the
-//! ramps carry no load, `F_spring + |M̂|·tanθ/r` while they do (engaged). Pack capacity
-//! `T_all = μ·(2N_f − 1)·r_f·F`; Table 1 with a Karnopp stick band gives `T`.
+//! torque. The axial force balance is quasi-static in the twin's **physical reading** (the
+//! ground truth; docs/monitor-design.md, "The physical reading, per scene"): the light connecting
+//! shaft gives `T = T_o + u` and `F = F_s + k·(T_o − u)`, the pack slipping at `μ_d` while the
+//! drive runs (`a = μ_d·c`, `k = tanθ/r`, `a·k` = 1.42 > 1) and self-locking at `μ_s` with the
+//! drive off. Table 1 with a Karnopp stick band gives `T`.
 //!
 //! A three-state observer (angle, speed, torque) on the 14-bit output encoder tracks
 //! `J_s·ω̇ − u` with the model's `T̂` fed forward, so scene changes are bumpless. The load `M̂`
-//! is learned only where it is well conditioned (pack released: `M = N + s·T_drag`), held where
-//! it is unobservable (locked), and compared with the measured braking torque where the pack
-//! slips (pack health).
+//! is learned only while driving, where the pack torque follows from the current alone, and is
+//! held with the drive off (braking lasts milliseconds, a locked shaft hides the load).
 //!
 //! | scene | when | model |
 //! |---|---|---|
-//! | `Driving` | drive on, input leads | pack at spring drag; learn `M̂`; drag and stuck-counter checks |
-//! | `Overrunning` | drive on, output faster than input | ramps engaged, pack slipping at `T_all(M̂)` |
-//! | `FaultBraking` | drive off, output moving | engaged when moving with the load, else spring drag; time/angle envelope |
-//! | `Holding` | drive off, output stuck ≥ dwell | `T = M̂` (≤ `T_all`); creep check |
+//! | `Driving` | drive on, drive carries the load | `F = F_s/(1 + a·k)` = 70 N, drag `a·F` = 1.98 N·m; learn `M̂`; drag and stuck-counter checks |
+//! | `Overrunning` | drive on, load along the motion (current-implied, see `step`) | `T = y = g₁·v − g₀` from the drive torque `v`, `F = y/a`; learn `M̂` |
+//! | `FaultBraking` | drive off, output moving | both socket faces clamp: `F = F_s + k·|T|`, `T` measured; time/angle envelope |
+//! | `Holding` | drive off, stopped 1 ms or reversed by an impact | `T = M̂`; creep-span check |
 //!
 //! # Formats
 //! | quantity | format | range | resolution |
@@ -49,8 +50,9 @@
 //! constant is derived in [`Monitor::new`].
 //!
 //! # Cost
-//! Measured by single-stepping QEMU over a 4000-tick drive/cut/brake/hold stream (release,
-//! LTO): Cortex-M3 mean 722, max 876 instructions per step; Cortex-M0 mean 1750, max 2423.
+//! `cargo xtask run --json` (Cortex-M3 under QEMU, the twin's reverse_load trace, release, LTO):
+//! mean 804.5, max 988 instructions per step (budget 1000). The load filter runs on even ticks
+//! and the drag check on odd ticks so that no step carries both.
 //!
 //! # Missed ticks
 //! The caller sets [`Inputs::ticks_elapsed`] to the number of ticks since the previous call
@@ -69,13 +71,24 @@ pub use config::{
 pub use io::{BrakeState, Estimate, Flags, Inputs, Scene, ESTIMATE_WORDS};
 pub use scale::{recip_q16, sat_i32, Scale, ScaleError};
 
-use crate::fx::{adc_centered, counter_delta, lowpass, mul_sat, Q16};
+use crate::fx::{adc_centered, counter_delta, lowpass, Q16};
 use config::Params;
 use fixed::types::U40F24;
 use observer::Observer;
 
 /// Largest capacity margin reported (loads below `min_load_nm` report this).
 pub const MARGIN_MAX: Q16 = Q16::from_bits(1000 << 16);
+
+/// `a·b` for two Q16 values, rounded toward −∞ and **saturated** to Q16: the same bits as
+/// `fx::mul_sat` (`fixed`'s `saturating_mul`, tested below), written out as one 32×32→64
+/// multiply, a shift and a clamp (cheaper on Cortex-M than the generic version).
+#[inline]
+fn mul_q16(a: Q16, b: Q16) -> Q16 {
+    // |a·b| ≤ 2^62: the product fits an i64; `>> 16` is the floor.
+    Q16::from_bits(sat_i32(
+        (i64::from(a.to_bits()) * i64::from(b.to_bits())) >> 16,
+    ))
+}
 
 /// Pack health is kept within [0, 2].
 const HEALTH_MAX: i32 = 2 << 16;
@@ -101,16 +114,27 @@ pub struct Monitor {
     locked: bool,
     engaged: bool,
     overrunning: bool,
+    /// Ticks for which the other driving reading (overrunning or not) has been wanted.
+    reading_ticks: u32,
+    /// The driving reading of this drive has been decided once (settled observer).
+    reading_decided: bool,
     scene: Scene,
     stick_ticks: u32,
     phase_ticks: u32,
     settle_ticks: u32,
     since_fault: u32,
     rail_ticks: u32,
+    /// Recent peak |ω̂| (Q16 bits), decaying at `impact_decay` per tick: the energy an impact
+    /// in the lost motion can still return.
+    impact_speed: i32,
+    /// Last non-zero direction of the output (−1, 0, 1).
+    last_dir: i32,
     innovation_ticks: u32,
     envelope: BrakingEnvelope,
     creep_valid: bool,
     creep_counts: i32,
+    creep_min: i32,
+    creep_max: i32,
     still_out: u32,
     still_motor: u32,
     weak_ticks: u32,
@@ -127,7 +151,7 @@ pub struct Monitor {
 struct LoadCache {
     load: Q16,
     valid: bool,
-    force: Q16,
+    /// Static capacity `μ_s·c·(F_s + k·|M̂|)` of the pack clamped by the load (drive off).
     capacity: Q16,
     recip: Q16,
     /// `min_capacity_margin · |M̂|` (N·m).
@@ -216,16 +240,22 @@ impl Monitor {
             locked: false,
             engaged: true,
             overrunning: false,
+            reading_ticks: 0,
+            reading_decided: false,
             scene: Scene::FaultBraking,
             stick_ticks: 0,
             phase_ticks: 0,
             settle_ticks: 0,
             since_fault: 0,
             rail_ticks: 0,
+            impact_speed: 0,
+            last_dir: 0,
             innovation_ticks: 0,
             envelope: BrakingEnvelope::default(),
             creep_valid: false,
             creep_counts: 0,
+            creep_min: 0,
+            creep_max: 0,
             still_out: 0,
             still_motor: 0,
             weak_ticks: 0,
@@ -236,7 +266,6 @@ impl Monitor {
             load_cache: LoadCache {
                 load: Q16::ZERO,
                 valid: false,
-                force: Q16::ZERO,
                 capacity: Q16::ZERO,
                 recip: Q16::ZERO,
                 margin_floor: Q16::ZERO,
@@ -255,7 +284,11 @@ impl Monitor {
         self.weak_ticks = 0;
         self.drag_ticks = 0;
         self.envelope = BrakingEnvelope::default();
+        // Creep is measured afresh from here (the span, not its validity: a reset while
+        // holding keeps the slip check armed).
         self.creep_counts = 0;
+        self.creep_min = 0;
+        self.creep_max = 0;
     }
 
     /// One tick: reads the raw inputs, advances the model, returns the estimate. Never panics;
@@ -275,7 +308,11 @@ impl Monitor {
         if code > p.adc_max_code {
             fault = true; // the converter cannot produce it
         }
-        if code == 0 || code >= p.adc_max_code {
+        let drive = inputs.drive_commanded;
+        // A drive at its current limit reads at the rail (the default ADC range is the drive's
+        // limit) while the motor moves; a rail with the motor encoder standing still is the ADC.
+        let motor_still = (inputs.motor_counter & p.motor_mask) == self.prev_motor;
+        if (code == 0 || code >= p.adc_max_code) && (!drive || motor_still || !self.started) {
             self.rail_ticks = self.rail_ticks.saturating_add(n);
         } else {
             self.rail_ticks = 0;
@@ -284,7 +321,6 @@ impl Monitor {
             fault = true;
         }
         let current = adc_centered(code, p.adc_bits); // |current| ≤ 2^15
-        let drive = inputs.drive_commanded;
         if !drive && current.saturating_abs() > p.current_off_counts {
             fault = true;
         }
@@ -375,8 +411,31 @@ impl Monitor {
         }
         self.settle_ticks = self.settle_ticks.saturating_add(n);
         let settled = self.settle_ticks >= p.settle_ticks;
-        let innovation = measured.wrapping_sub(self.obs.theta) as i32; // shortest angle
-        if settled && innovation.saturating_abs() > p.innovation_limit.times(n_i) {
+        // Shortest signed angle (wrapping on purpose: the encoder is modular).
+        let innovation = measured.wrapping_sub(self.obs.theta) as i32;
+        // Plausible prediction error: one tick at the fastest speed, plus, with the drive off,
+        // an impact in the lost motion reversing the recent peak speed within `impact_time_s`
+        // (the twin's output stops on impact within 2–10 ms and rattles at up to ±8 rad/s).
+        // The peak decays at IMPACT_DECAY_RAD_S2 (saturating: it never goes below 0 nor
+        // wraps). The widened limit is only formed when the base limit is exceeded (cheaper on
+        // every other tick).
+        if drive {
+            // Driving: no impacts; the peak restarts from the speed at the next cut.
+            self.impact_speed = 0;
+        } else {
+            self.impact_speed = self
+                .impact_speed
+                .saturating_sub(p.impact_decay.times(n_i))
+                .max(self.obs.v.saturating_abs());
+        }
+        let base_limit = p.innovation_limit.times(n_i);
+        let implausible = settled
+            && innovation.saturating_abs() > base_limit
+            && innovation.saturating_abs()
+                > p.impact_words
+                    .apply(self.impact_speed)
+                    .saturating_add(base_limit);
+        if implausible {
             // The encoder disagrees with any plausible motion: do not let it kick the model.
             self.innovation_ticks = self.innovation_ticks.saturating_add(n);
             fault = true;
@@ -430,17 +489,55 @@ impl Monitor {
             self.prev_drive = drive;
         }
 
-        // ---- Scene recognition and the stick/slip state machine (hysteresis: stick band,
-        // dwell, breakaway speed above the band — no chatter at zero speed).
+        // ---- Scene recognition and the stick/slip state machine.
+        // Drive on (physical reading, quasi-static, pack slipping at μ_d, a = μ_d·c, k = tanθ/r,
+        // a·k > 1): with the drive torque `v` along the motion, either the drive carries a
+        // load against the motion (pack at the drive drag, `v = |M| + T_drive`), or the load
+        // runs along it (overrunning) and the pack torque is `y = g₁·v − g₀` with the load
+        // `y − v` along the motion. The current tells them apart only when the overrunning
+        // reading's load lies outside the envelope; otherwise the learned load's sign decides,
+        // and with no load known yet the overrunning reading is taken (docs: "ambiguity").
+        let v = signed(s, self.drive_torque);
+        // y is needed while overrunning, or to test for it unless a known load is against the
+        // motion (then the reading is settled and the product is skipped: cheaper).
+        // Saturating: a clipped torque is the safe answer.
+        let load_along = signed(s, self.load) > min_load;
+        let overrun_torque =
+            if drive && s != 0 && (self.overrunning || !self.load_known || load_along) {
+                Q16::from_bits(p.overrun_gain.apply(v.to_bits()))
+                    .saturating_sub(p.overrun_offset)
+                    .max(Q16::ZERO)
+            } else {
+                Q16::ZERO // not used: drive off, output still, or a known load against the motion
+            };
         if drive && s != 0 {
-            let lead = signed(s, w.saturating_sub(self.input_speed));
-            if lead > p.overrun_band {
-                self.overrunning = true;
-            } else if lead <= Q16::ZERO {
-                self.overrunning = false;
+            let implied = overrun_torque.saturating_sub(v);
+            // Before the observer has settled (power-on) ω̂ and the drive torque are not in the
+            // quasi-static balance the test needs: the cheaper drive-carries reading is kept.
+            let possible =
+                settled && v > p.drive_drag && implied > min_load && implied <= p.max_load;
+            let wanted = possible && (!self.load_known || load_along);
+            // Debounce: after the first settled decision of a drive, the other reading must
+            // hold for the engage settling time before the scene switches, so that a transient
+            // (crossing the lost motion) or noise at the envelope's edge cannot toggle the scene
+            // and restart the load learning.
+            if settled && !self.reading_decided {
+                self.reading_decided = true;
+                self.overrunning = wanted;
+                self.reading_ticks = 0;
+            } else if wanted == self.overrunning {
+                self.reading_ticks = 0;
+            } else {
+                self.reading_ticks = self.reading_ticks.saturating_add(n);
+                if self.reading_ticks >= p.engage_settle_ticks {
+                    self.overrunning = wanted;
+                    self.reading_ticks = 0;
+                }
             }
         } else {
             self.overrunning = false;
+            self.reading_ticks = 0;
+            self.reading_decided = false;
         }
         if drive {
             self.locked = false;
@@ -451,21 +548,27 @@ impl Monitor {
             } else {
                 self.stick_ticks = 0;
             }
-            if !self.locked && self.stick_ticks >= p.lock_dwell_ticks {
+            // The brake stops the output: it dwells in the stick band, or an impact in the
+            // lost motion reverses it within a tick or two.
+            let reversed = s != 0 && s == -self.last_dir;
+            if !self.locked && (self.stick_ticks >= p.lock_dwell_ticks || reversed) {
+                // The output stopped under the brake: the pack holds. From here on it may only
+                // move inside the lost motion (backlash, contact compliance, ball play).
                 self.locked = true;
-            } else if self.locked && w.saturating_abs() > p.breakaway_speed {
-                self.locked = false;
+                if !self.creep_valid {
+                    self.creep_valid = true;
+                    self.creep_counts = 0;
+                    self.creep_min = 0;
+                    self.creep_max = 0;
+                }
             }
         }
-        let engaged = if drive {
-            self.overrunning
-        } else if self.locked || s == 0 {
-            // Drive off and (nearly) still: the only torque that can move the output is the
-            // load, and moving with the load engages the ramps.
-            true
-        } else {
-            load_sign == 0 || s == load_sign
-        };
+        if s != 0 {
+            self.last_dir = s;
+        }
+        // Drive off: both faces of the V sockets push the pack, so the ramps clamp it whichever
+        // way the output turns (the physical reading); drive on: only when overrunning.
+        let engaged = !drive || self.overrunning;
         let scene = if drive {
             if self.overrunning {
                 Scene::Overrunning
@@ -487,21 +590,39 @@ impl Monitor {
         let phase_settled = self.phase_ticks >= p.engage_settle_ticks;
 
         // ---- Load: learned where well conditioned, held elsewhere.
-        let moving_ok = settled && sensors_ok && s != 0 && !self.locked && phase_settled;
-        if moving_ok && !engaged {
-            // Pack at its spring drag: M = N + s·T_drag (κ = 1).
-            let inst = net.saturating_add(signed(s, p.spring_drag));
+        // (No learning while a change of the driving reading is pending: the pack torque it
+        // would use is the one being left.)
+        let moving_ok = settled
+            && sensors_ok
+            && s != 0
+            && !self.locked
+            && phase_settled
+            && self.reading_ticks == 0;
+        // Cost: the load filter (with the load cache it invalidates) runs on even ticks and
+        // the drag check on odd ticks, so no step carries both (each at 5 kHz, counting two
+        // ticks per run; the flags' persistence and the filter's 10 Hz are unchanged).
+        let even_tick = self.tick & 1 == 0;
+        if moving_ok && drive && even_tick {
+            // The pack torque is known while the drive runs: the drive drag when the drive
+            // carries the load, the overrunning equilibrium when the load runs along:
+            // M = N + s·T_pack.
+            let pack = if engaged {
+                overrun_torque
+            } else {
+                p.drive_drag
+            };
+            let inst = net.saturating_add(signed(s, pack));
             self.load = lowpass(self.load, inst, p.load_alpha);
-            self.load_learn_ticks = self.load_learn_ticks.saturating_add(n);
+            self.load_learn_ticks = self.load_learn_ticks.saturating_add(n.saturating_mul(2));
             if self.load_learn_ticks >= p.load_known_ticks {
+                if !self.load_known && !self.load_ref_known {
+                    // First known load of a drive that started without one (power-on while
+                    // driving): it is the drag check's reference from here on.
+                    self.load_ref = self.load;
+                    self.load_ref_known = true;
+                }
                 self.load_known = true;
             }
-        } else if moving_ok && engaged && !self.load_known {
-            // Unknown load, ramps engaged (power-on while moving): invert the engaged balance
-            // N = M(1 − μ'·tanθ/r) − s·T_drag assuming the load drives the motion. Untrusted.
-            let inst = net.saturating_add(signed(s, p.spring_drag));
-            let inst = Q16::from_bits(p.inv_engaged_kappa.apply(inst.to_bits()));
-            self.load = lowpass(self.load, inst, p.load_alpha);
         }
         let load_abs = self.load.saturating_abs();
         if !self.load_cache.valid || self.load_cache.load != self.load {
@@ -511,19 +632,17 @@ impl Monitor {
             self.load_cache = LoadCache {
                 load: self.load,
                 valid: true,
-                force,
                 capacity: Q16::from_bits(p.capacity_per_n.apply(force.to_bits())),
                 recip: Q16::from_bits(recip_q16(load_abs.to_bits())),
                 margin_floor: Q16::from_bits(p.min_margin.apply(load_abs.to_bits())),
             };
         }
-        let engaged_force = self.load_cache.force;
         let engaged_capacity = self.load_cache.capacity;
         let measured_brake = self.load.saturating_sub(net);
 
         // ---- Pack health (sign-LMS, no division): measured over model torque while slipping.
-        if moving_ok && engaged && self.load_known {
-            let predicted = mul_sat(self.health, engaged_capacity);
+        if moving_ok && !drive && self.load_known {
+            let predicted = mul_q16(self.health, engaged_capacity);
             let step = if signed(s, measured_brake) > predicted {
                 p.health_step
             } else {
@@ -538,7 +657,7 @@ impl Monitor {
         }
 
         // ---- Flags.
-        let available = mul_sat(self.health, engaged_capacity);
+        let available = mul_q16(self.health, engaged_capacity);
         let margin_low =
             self.load_known && load_abs >= min_load && available < self.load_cache.margin_floor;
         self.weak_ticks = if margin_low {
@@ -550,16 +669,17 @@ impl Monitor {
             self.flags.brake_weak = true;
         }
         // Braking envelope: a nominal model started at the cut (speed decreasing at
-        // (T_all − |M̂|)/J_s while engaged, (|M̂| + T_drag)/J_s while coasting against the load)
-        // gives the expected speed and angle; the output may overrun them by the allowances.
+        // (T_all − |M̂|)/J_s moving with the load, (T_all + |M̂|)/J_s against it: both socket
+        // faces clamp) gives the expected speed and angle; the output may overrun them by the
+        // allowances. (The twin's healthy pack stops on impact, far inside this envelope.)
         if scene == Scene::FaultBraking && !settled {
             self.envelope.arm(w);
         } else if scene == Scene::FaultBraking && out_ok {
             let env = &mut self.envelope;
-            let decel = if engaged {
+            let decel = if s == load_sign {
                 engaged_capacity.saturating_sub(load_abs)
             } else {
-                load_abs.saturating_add(p.spring_drag)
+                engaged_capacity.saturating_add(load_abs)
             }
             .max(Q16::ZERO);
             let dv = p.obs.v_a.apply(decel.to_bits()).times(n_i);
@@ -583,48 +703,46 @@ impl Monitor {
                 self.flags.brake_weak = true;
             }
         }
-        if !drive {
-            if self.locked {
-                self.creep_valid = true;
-            }
-            if self.creep_valid && out_ok {
-                self.creep_counts = self.creep_counts.saturating_add(d_out);
-                if self.creep_counts.saturating_abs() > p.creep_counts {
-                    self.flags.brake_slip = true;
-                }
+        // Creep: the span of the output's travel since the brake first held. Rattling inside
+        // the lost motion keeps it bounded; a slipping pack (steady or staircase) grows it.
+        if !drive && self.creep_valid && out_ok {
+            self.creep_counts = self.creep_counts.saturating_add(d_out);
+            self.creep_min = self.creep_min.min(self.creep_counts);
+            self.creep_max = self.creep_max.max(self.creep_counts);
+            if self.creep_max.saturating_sub(self.creep_min) > p.creep_counts {
+                self.flags.brake_slip = true;
+                self.locked = false;
+                self.creep_valid = false;
             }
         }
-        if scene == Scene::Driving && moving_ok {
-            let implied = net.saturating_add(signed(s, p.spring_drag)); // load if drag nominal
-            let over_model = implied.saturating_abs() > p.max_load;
-            let excess = self.load_ref_known
-                && signed(s, self.load_ref.saturating_sub(net))
-                    > p.spring_drag.saturating_add(p.drag_allowance);
-            self.drag_ticks = if over_model || excess {
-                self.drag_ticks.saturating_add(n)
+        if !even_tick {
+            if scene == Scene::Driving && moving_ok {
+                // s = ±1 here (moving).
+                let implied = net.saturating_add(signed(s, p.drive_drag)); // load if drag nominal
+                let over_model = implied.saturating_abs() > p.max_load;
+                let excess = self.load_ref_known
+                    && signed(s, self.load_ref.saturating_sub(net)) > p.drag_limit;
+                self.drag_ticks = if over_model || excess {
+                    self.drag_ticks.saturating_add(n.saturating_mul(2))
+                } else {
+                    0
+                };
+                if self.drag_ticks >= p.persistence_ticks {
+                    self.flags.brake_drag = true;
+                }
             } else {
-                0
-            };
-            if self.drag_ticks >= p.persistence_ticks {
-                self.flags.brake_drag = true;
+                self.drag_ticks = 0;
             }
-        } else {
-            self.drag_ticks = 0;
         }
 
         // ---- Table 1 with the stick band: the braking torque of this tick, fed forward into
         // the next prediction (with the load only once it is known, so that learning it cannot
         // feed back through the pack capacity).
-        let force = if engaged {
-            engaged_force
-        } else {
-            p.spring_force
-        };
         let stuck = self.locked || s == 0;
         let capacity = if engaged {
             engaged_capacity
         } else {
-            p.spring_drag
+            p.drive_drag
         };
         // Table 1: stuck → the pack carries the demand up to its capacity; slipping → capacity
         // against the motion. The reported torque's demand is the load estimate; the model's
@@ -640,9 +758,50 @@ impl Monitor {
                 signed(s, cap)
             }
         };
-        let braking_torque = table1(self.load.saturating_add(self.drive_torque), capacity);
-        let model_capacity = if engaged && !self.load_known {
-            p.spring_drag
+        // Reported pack torque and pressing force (physical reading, quasi-static):
+        // - drive carrying the load: the drive drag `T_drive = a·F_drive` at the unloaded
+        //   force `F_drive = F_s/(1 + a·k)`;
+        // - overrunning: the equilibrium torque `y` from the drive torque alone (no learned
+        //   load needed), and the force of the light connecting shaft's axial balance
+        //   `F = F_s + k·(T_o − v)` with `T_o = y − v` through the output ramps;
+        // - drive off: both faces of the V sockets clamp, `F = F_s + k·|T|` with `T` the held
+        //   load (stuck) or the measured braking torque (moving).
+        let (force, braking_torque) = if drive && !engaged {
+            (
+                p.drive_force,
+                table1(self.load.saturating_add(self.drive_torque), capacity),
+            )
+        } else if drive {
+            let excess = overrun_torque.saturating_sub(v).saturating_sub(v); // T_o − v
+            (
+                p.spring_force
+                    .saturating_add(Q16::from_bits(p.ramp_factor.apply(excess.to_bits())))
+                    .max(Q16::ZERO),
+                signed(s, overrun_torque),
+            )
+        } else {
+            let t = if stuck { self.load } else { measured_brake };
+            (
+                p.spring_force.saturating_add(Q16::from_bits(
+                    p.ramp_factor.apply(t.saturating_abs().to_bits()),
+                )),
+                t,
+            )
+        };
+        // Table 1: the pack cannot carry more than its capacity at that force. Inside the
+        // envelope this never binds (driving: `μ_d·c·F < μ_s·c·F`; drive off: a self-locking
+        // pack, μ_s·c·k = 2.49 at Table 2, carries `T` at `F_s + k·|T|`); it bounds the
+        // estimate when the force saturates (hostile inputs) or the pack does not self-lock.
+        // (Driving with the drive carrying the load needs none: the drag `μ_d·c·F_drive` is a
+        // constant below `μ_s·c·F_drive`; skipping it keeps the driving step cheaper.)
+        let braking_torque = if drive && !engaged {
+            braking_torque
+        } else {
+            let cap_now = Q16::from_bits(p.capacity_per_n.apply(force.to_bits())).max(Q16::ZERO);
+            braking_torque.min(cap_now).max(cap_now.saturating_neg())
+        };
+        let model_capacity = if drive && engaged {
+            overrun_torque
         } else {
             capacity
         };
@@ -653,7 +812,7 @@ impl Monitor {
 
         // ---- Friction energy: slip power |T·ω| integrated (saturating; monotone).
         if !self.locked {
-            let power = mul_sat(braking_torque, w).saturating_abs();
+            let power = mul_q16(braking_torque, w).saturating_abs();
             let joules = p.energy_per_tick.apply(power.to_bits()).max(0) as u64 * u64::from(n);
             self.energy = U40F24::from_bits(self.energy.to_bits().saturating_add(joules));
         }
@@ -661,7 +820,7 @@ impl Monitor {
         let capacity_margin = if load_abs < min_load {
             MARGIN_MAX
         } else {
-            mul_sat(available, self.load_cache.recip).min(MARGIN_MAX)
+            mul_q16(available, self.load_cache.recip).min(MARGIN_MAX)
         };
         let brake = if self.locked {
             BrakeState::Locked
@@ -686,6 +845,49 @@ impl Monitor {
             friction_energy_j: self.energy,
             trusted: self.load_known && settled && sensors_ok && n <= u32::from(p.max_catchup),
             flags: self.flags,
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::fx::mul_sat;
+
+    #[test]
+    fn mul_q16_has_the_bits_of_fixed_saturating_mul() {
+        let mut x = 0x2545_F491_u32;
+        let mut next = || {
+            x ^= x << 13;
+            x ^= x >> 17;
+            x ^= x << 5;
+            x as i32
+        };
+        let edges = [
+            0,
+            1,
+            -1,
+            65_536,
+            -65_536,
+            i32::MAX,
+            i32::MIN,
+            0x7FFF,
+            -0x8000,
+        ];
+        for &a in &edges {
+            for &b in &edges {
+                let (qa, qb) = (Q16::from_bits(a), Q16::from_bits(b));
+                assert_eq!(mul_q16(qa, qb), mul_sat(qa, qb), "{a} × {b}");
+            }
+        }
+        for _ in 0..100_000 {
+            // Full range, and values of physical size (|x| < 2^24 bits = 256).
+            let (a, b) = (next(), next());
+            let (c, d) = (next() >> 8, next() >> 8);
+            for (a, b) in [(a, b), (c, d), (a, d)] {
+                let (qa, qb) = (Q16::from_bits(a), Q16::from_bits(b));
+                assert_eq!(mul_q16(qa, qb), mul_sat(qa, qb), "{a} × {b}");
+            }
         }
     }
 }

@@ -276,11 +276,22 @@ fn constructor_rejects_out_of_range_parameters() {
         }
     );
     let mut c = Config::default();
-    c.thresholds.breakaway_speed_rad_s = 0.1;
+    c.thresholds.impact_time_s = 0.0;
     assert_eq!(
         err(c),
         ConfigError::OutOfRange {
-            parameter: "thresholds.breakaway_speed_rad_s"
+            parameter: "thresholds.impact_time_s"
+        }
+    );
+    // μ_d·c·k = 1 would make the overrunning equilibrium singular (0.17 gives 1.42).
+    let c = Config {
+        sliding_mu: 0.17 / 1.417,
+        ..Config::default()
+    };
+    assert_eq!(
+        err(c),
+        ConfigError::OutOfRange {
+            parameter: "sliding_mu"
         }
     );
     let mut c = Config::default();

@@ -2,6 +2,15 @@
 //! ideal speed-servo drive, quasi-static pack with Table 1 stick/slip) produces quantised
 //! encoder counts and ADC codes; the monitor's estimates are checked against the plant's truth.
 //!
+//! The plant follows the twin's physical reading (docs/monitor-design.md, "physical reading"),
+//! quasi-statically: while driving the pack slips at μ_d — at the drive drag
+//! `μ_d·c·F_s/(1 + μ_d·c·k)` when the drive carries the load, at `μ_d·c·(F_s + 2k·M)/(1 + μ_d·c·k)`
+//! when the load runs along the motion — and with the drive off both faces of the V sockets
+//! clamp the pack, capacity `μ_s·c·(F_s + k·|M|)` whichever way the output turns. What the
+//! plant leaves out (the contact impacts, the rattle in the lost motion, the lost motion
+//! itself) is exercised on twin traces in `monitor_twin_faults.rs` and
+//! `monitor_paper_scenes.rs`.
+//!
 //! The plant is written here, independently of the monitor's code, from the same
 //! `noback::mechanism` and `noback::sensors` numbers (one source of truth for parameters).
 
@@ -32,6 +41,12 @@ struct Plant {
     out_offset: f64,
     /// Friction energy dissipated in the pack (J).
     energy: f64,
+    /// `energy` after each tick.
+    energy_log: Vec<f64>,
+    /// Pressing force while driving (N), the last sub-step of the tick.
+    drive_force: f64,
+    /// `drive_force` after each tick.
+    drive_force_log: Vec<f64>,
 }
 
 impl Plant {
@@ -50,6 +65,9 @@ impl Plant {
             rng: 0x1234_5678,
             out_offset: 16_300.0,
             energy: 0.0,
+            energy_log: Vec::new(),
+            drive_force: 0.0,
+            drive_force_log: Vec::new(),
         }
     }
 
@@ -57,8 +75,21 @@ impl Plant {
         self.mech.pack_torque_per_newton_m(self.mech.mu_static) * self.pack_factor
     }
 
-    fn spring_drag(&self) -> f64 {
-        self.per_newton() * self.mech.spring_preload_n()
+    /// Sliding self-locking ratio μ_d·c·k of the physical reading.
+    fn sliding_ratio(&self) -> f64 {
+        self.mech.pack_torque_per_newton_m(self.mech.mu_dynamic)
+            * self.pack_factor
+            * self.mech.ramp_factor_per_m()
+    }
+
+    /// Pack torque while driving (physical reading, quasi-static, pack slipping at μ_d): the
+    /// drive carries the load (`along ≤ 0`): `μ_d·c·F_s/(1 + μ_d·c·k)`; the load runs along the
+    /// motion (`along` = the output ramps' torque along the motion):
+    /// `μ_d·c·(F_s + 2k·along)/(1 + μ_d·c·k)`.
+    fn drive_drag(&self, along: f64) -> f64 {
+        let a = self.mech.pack_torque_per_newton_m(self.mech.mu_dynamic) * self.pack_factor;
+        let k = self.mech.ramp_factor_per_m();
+        a * (self.mech.spring_preload_n() + 2.0 * k * along.max(0.0)) / (1.0 + self.sliding_ratio())
     }
 
     /// Capacity with the ramps engaged (pressing force from the load, quasi-static).
@@ -85,7 +116,12 @@ impl Plant {
                     } else {
                         0.0
                     };
-                    let pack = s * (self.spring_drag() + self.extra_drag_nm);
+                    let along = s * (m - j * dw / dt);
+                    let drag = self.drive_drag(along);
+                    self.drive_force = drag
+                        / (self.mech.pack_torque_per_newton_m(self.mech.mu_dynamic)
+                            * self.pack_factor);
+                    let pack = s * (drag + self.extra_drag_nm);
                     let u = if s == 0.0 { -m } else { j * dw / dt - m + pack };
                     u_sum += u;
                     self.energy += (pack * 0.5 * (self.omega + w_new)).abs() * dt;
@@ -94,12 +130,8 @@ impl Plant {
                     self.omega = w_new;
                 }
                 None => {
-                    let engaged = self.omega == 0.0 || self.omega.signum() == m.signum();
-                    let cap = if engaged {
-                        self.engaged_capacity()
-                    } else {
-                        self.spring_drag()
-                    };
+                    // Drive off: both faces of the V sockets clamp the pack (physical reading).
+                    let cap = self.engaged_capacity();
                     if self.omega == 0.0 {
                         if m.abs() <= cap {
                             continue; // stuck: the pack carries the load (Table 1)
@@ -128,6 +160,8 @@ impl Plant {
             }
         }
         self.drive_torque = u_sum / f64::from(SUBSTEPS);
+        self.energy_log.push(self.energy);
+        self.drive_force_log.push(self.drive_force);
     }
 
     fn next_noise(&mut self) -> i32 {
@@ -238,16 +272,17 @@ fn check_paper_case(load: f64, speed: f64, name: &str) {
         last.pack_health.to_num::<f64>(),
     );
     // Heat: the monitor integrates |T·ω| of its own Table 1 torque and observed speed; the plant
-    // integrates the true pack torque over the true travel.
-    let energy = last.friction_energy_j.to_num::<f64>();
-    println!(
-        "{name}: friction energy {energy:.3} J, plant {:.3} J",
-        plant.energy
-    );
+    // integrates the true pack torque over the true travel. Compared from the end of the
+    // observer's settling (power-on while moving: the monitor keeps the cheap drive-carries
+    // reading, untrusted, until then).
+    let settle = (Config::default().thresholds.settle_time_s * TICK_HZ).round() as usize;
+    let energy =
+        last.friction_energy_j.to_num::<f64>() - trace[settle].2.friction_energy_j.to_num::<f64>();
+    let plant_energy = plant.energy - plant.energy_log[settle];
+    println!("{name}: friction energy after settling {energy:.3} J, plant {plant_energy:.3} J");
     assert!(
-        (energy - plant.energy).abs() <= 0.05 * plant.energy,
-        "energy {energy} vs {}",
-        plant.energy
+        (energy - plant_energy).abs() <= 0.05 * plant_energy,
+        "energy {energy} vs {plant_energy}"
     );
     assert!(
         (hold - load).abs() <= 0.05 * load.abs(),
@@ -261,16 +296,27 @@ fn check_paper_case(load: f64, speed: f64, name: &str) {
     assert_eq!(last.scene, Scene::Holding);
     assert!(last.trusted);
     assert!(!last.flags.any(), "false alarm: {:?}", last.flags);
-    // Lock seen after the plant locked, within the dwell plus 10 ms.
+    // Lock seen within 10 ms of the plant's (issue 4's target). The physical reading's dwell
+    // is 1 ms, so the monitor may call the lock in the last ~1 ms of the plant's creep into
+    // the stick band, just before the plant stops.
     assert!(
-        lock_seen >= lock_true && lock_seen - lock_true <= 0.02,
+        (lock_seen - lock_true).abs() <= 0.01,
         "{lock_seen} vs {lock_true}"
     );
-    // While driving (settled) the pack is released at spring pressure.
-    let driving = trace.iter().find(|x| x.0 > 0.15).unwrap().2;
-    assert_eq!(driving.scene, Scene::Driving);
-    assert_eq!(driving.brake, BrakeState::Released);
-    assert!((driving.pressing_force_n.to_num::<f64>() - spring).abs() < 0.01);
+    // While driving (settled), physical reading: the drive carrying the load unloads the pack to
+    // F_s/(1 + μ_d·c·k); a load running along the motion engages the ramps (overrunning).
+    let k = ((0.15 * TICK_HZ).round() as usize).min(trace.len() - 1);
+    let driving = trace[k].2;
+    let force = driving.pressing_force_n.to_num::<f64>();
+    let want = plant.drive_force_log[k];
+    if load * speed < 0.0 {
+        assert_eq!(driving.scene, Scene::Driving);
+        assert_eq!(driving.brake, BrakeState::Released);
+    } else {
+        assert_eq!(driving.scene, Scene::Overrunning);
+        assert_eq!(driving.brake, BrakeState::Slipping);
+    }
+    assert!((force - want).abs() <= 0.05 * want, "{force} vs {want}");
 }
 
 #[test]
@@ -290,24 +336,10 @@ fn negative_load_mirrors() {
     check_paper_case(-12.0, -8.0, "negative forward");
 }
 
-#[test]
-fn worn_pack_raises_brake_weak_within_50_ms_of_the_cut() {
-    let mut plant = Plant::new(20.3, 13.78);
-    plant.pack_factor = 0.5;
-    let mut monitor = Monitor::new(Config::default()).unwrap();
-    let trace = run(&mut plant, &mut monitor, 13.78, 0.2, 0.8);
-    dump(&trace, "worn");
-    let weak = first_time(&trace, |x| x.2.flags.brake_weak).unwrap();
-    let last = trace.last().unwrap().2;
-    println!(
-        "worn pack: brake_weak at {weak:.4} s, health {:.3}, margin {:.3}",
-        last.pack_health.to_num::<f64>(),
-        last.capacity_margin.to_num::<f64>()
-    );
-    assert!(weak > 0.2 && weak - 0.2 <= 0.05, "{weak}");
-    assert!(!last.flags.brake_slip && !last.flags.brake_drag && !last.flags.sensor_fault);
-    assert!(last.capacity_margin.to_num::<f64>() < 1.5);
-}
+// The worn pack (μ × 0.5) of the paper reading is not a failure in the physical reading: with
+// the drive off the pack still self-locks (μ_s·c·k·0.5 = 1.25 > 1) and holds the load. A pack
+// that really fails to hold is tested on twin traces (`monitor_twin_faults.rs`:
+// friction_loss 0.9 → brake_weak within 50 ms of the cut).
 
 #[test]
 fn pack_losing_grip_while_holding_raises_brake_slip() {
@@ -315,17 +347,38 @@ fn pack_losing_grip_while_holding_raises_brake_slip() {
     let mut monitor = Monitor::new(Config::default()).unwrap();
     let mut trace = run(&mut plant, &mut monitor, 13.78, 0.2, 0.5);
     assert!(!trace.last().unwrap().2.flags.any());
-    // The spring breaks and μ drops: capacity 0.3 × nominal < load.
+    // The spring breaks and μ drops: capacity 0.3 × nominal < load, and μ_s·c·k·0.3 < 1: the
+    // pack no longer self-locks and the output creeps away under the load.
     plant.pack_factor = 0.3;
+    let start = plant.theta;
+    let limit = Config::default().thresholds.creep_limit_rad;
+    let mut beyond = None;
     for k in 0..3000 {
         plant.tick(None);
         let e = monitor.step(&plant.inputs(false));
-        trace.push((0.5 + f64::from(k + 1) * H, plant.omega, e));
+        let t = 0.5 + f64::from(k + 1) * H;
+        if beyond.is_none() && (plant.theta - start).abs() > limit {
+            beyond = Some(t);
+        }
+        trace.push((t, plant.omega, e));
     }
     let slip = first_time(&trace, |x| x.2.flags.brake_slip).unwrap();
     let moved = first_time(&trace, |x| x.0 > 0.5 && x.1 != 0.0).unwrap();
-    println!("slip: output moving at {moved:.4} s, brake_slip at {slip:.4} s");
-    assert!(slip > moved && slip - moved <= 0.1, "{slip} vs {moved}");
+    let beyond = beyond.unwrap();
+    println!(
+        "slip: output moving at {moved:.4} s, beyond the creep limit at {beyond:.4} s, brake_slip at {slip:.4} s"
+    );
+    // The creep limit (0.15 rad) must exceed the rattle in the lost motion after an impact
+    // stop (≈ 0.1 rad in the twin), so a slow creep (here 17 rad/s²) is flagged when it has
+    // crossed the limit — within a tick and one encoder count of it — not within a fixed time.
+    assert!(slip > moved, "{slip} vs {moved}");
+    assert!(slip <= beyond + 0.001, "{slip} vs {beyond}");
+    let last = trace.last().unwrap().2;
+    assert!(
+        !last.flags.sensor_fault && !last.flags.brake_drag,
+        "{:?}",
+        last.flags
+    );
 }
 
 #[test]
@@ -383,23 +436,45 @@ mod envelope {
     use super::*;
     use proptest::prelude::*;
 
-    /// Shadow of the estimate's derived fields, recomputed in f64 from its own load estimate.
+    /// Shadow of the estimate's derived fields, recomputed in f64 from its own estimates (load,
+    /// drive torque, braking torque) with the physical reading's laws.
     fn check_shadow(e: &Estimate) -> Result<(), TestCaseError> {
         let m = TABLE2;
         let load = e.load_torque_nm.to_num::<f64>();
-        let engaged = e.brake != BrakeState::Released;
-        let force = if engaged {
-            m.quasi_static_pressing_force_n(load)
-        } else {
-            m.spring_preload_n()
-        };
+        let spring = m.spring_preload_n();
+        let k = m.ramp_factor_per_m();
+        let a = m.pack_torque_per_newton_m(m.mu_dynamic);
+        let ak = a * k;
         let got = e.pressing_force_n.to_num::<f64>();
+        let torque = e.braking_torque_nm.to_num::<f64>();
+        let (force, want_torque) = match e.scene {
+            // Drive carrying the load: the input ramps unload the pack.
+            Scene::Driving => (spring / (1.0 + ak), None),
+            // Overrunning: equilibrium torque from the drive torque along the motion.
+            Scene::Overrunning => {
+                let s = e.output_speed_rad_s.to_num::<f64>().signum();
+                let v = s * e.drive_torque_nm.to_num::<f64>();
+                let y = ((2.0 * ak * v - a * spring) / (ak - 1.0)).max(0.0);
+                ((spring + k * (y - 2.0 * v)).max(0.0), Some(s * y))
+            }
+            // Drive off: both faces clamp, F = F_s + k·|T|.
+            Scene::FaultBraking | Scene::Holding => (spring + k * torque.abs(), None),
+        };
         prop_assert!(
-            (got - force).abs() <= 1e-3 * force,
-            "force {} vs {}",
+            (got - force).abs() <= 1e-3 * force + 0.05,
+            "{:?}: force {} vs {}",
+            e.scene,
             got,
             force
         );
+        if let Some(want) = want_torque {
+            prop_assert!(
+                (torque - want).abs() <= 1e-3 * want.abs() + 0.01,
+                "overrunning torque {} vs {}",
+                torque,
+                want
+            );
+        }
         if load.abs() >= 1.0 {
             let cap = m.pack_capacity_nm(m.quasi_static_pressing_force_n(load), m.mu_static);
             let margin = e.pack_health.to_num::<f64>() * cap / load.abs();
@@ -412,10 +487,29 @@ mod envelope {
             );
         }
         if e.brake == BrakeState::Locked {
-            let got = e.braking_torque_nm.to_num::<f64>();
-            prop_assert!((got - load).abs() <= 1e-4, "holding {} vs {}", got, load);
+            prop_assert!(
+                (torque - load).abs() <= 1e-4,
+                "holding {} vs {}",
+                torque,
+                load
+            );
         }
         Ok(())
+    }
+
+    /// For a load against the motion whose steady drive torque `v` also fits an overrunning
+    /// load `M' = y(v) − v` inside the envelope, `Some(M')` (signed along the motion).
+    fn ambiguous_reading(plant: &Plant, load: f64, speed: f64) -> Option<f64> {
+        let m = TABLE2;
+        if load * speed >= 0.0 {
+            return None;
+        }
+        let a = m.pack_torque_per_newton_m(m.mu_dynamic);
+        let ak = a * m.ramp_factor_per_m();
+        let v = load.abs() + plant.drive_drag(-load.abs());
+        let along = (2.0 * ak * v - a * m.spring_preload_n()) / (ak - 1.0) - v;
+        let t = Config::default().thresholds;
+        (along > t.min_load_nm && along <= t.max_load_nm).then_some(speed.signum() * along)
     }
 
     proptest! {
@@ -423,7 +517,8 @@ mod envelope {
 
         /// The Monte Carlo range of issue 4 (load 5–30 N·m either way, 5–20 rad/s either way,
         /// here widened to 2 N·m and 2 rad/s): released at 0.3 s, the output locks and the
-        /// monitor holds the load within 5 %, with no flag.
+        /// monitor holds the load within 5 %, with no flag. Loads whose power-on drive torque
+        /// is ambiguous are the next test's.
         #[test]
         fn release_to_lock_across_the_drive_envelope(
             load in 2.0_f64..30.0, load_neg in any::<bool>(),
@@ -433,6 +528,7 @@ mod envelope {
             let load = if load_neg { -load } else { load };
             let speed = if speed_neg { -speed } else { speed };
             let mut plant = Plant::new(load, speed);
+            prop_assume!(ambiguous_reading(&plant, load, speed).is_none());
             plant.out_offset = offset;
             let mut monitor = Monitor::new(Config::default()).unwrap();
             let trace = run(&mut plant, &mut monitor, speed, 0.3, 1.0);
@@ -449,6 +545,45 @@ mod envelope {
             prop_assert!(last.trusted);
             let hold = last.braking_torque_nm.to_num::<f64>();
             prop_assert!((hold - load).abs() <= 0.05 * load.abs(), "hold {} vs {}", hold, load);
+        }
+
+        /// Powered on while driving, the monitor sees one steady drive torque `v`. In the
+        /// physical reading a load `M` against the motion gives `v = |M| + T_drive`, and a load
+        /// `M'` along it gives the same `v` when `M' = y(v) − v` (overrunning equilibrium); with
+        /// no load known the monitor takes the overrunning reading whenever `M'` lies in the
+        /// envelope (docs/monitor-design.md, "ambiguity at power-on"). For such against-loads
+        /// (|M| up to about 10 N·m) the monitor must still stay consistent — the derived fields
+        /// match their shadows, the output locks, no flag — and hold one of the two readings,
+        /// normally `M'`, within 5 %. (The speed check of the previous test does not apply: the model brakes
+        /// the wrong load for the first milliseconds after the cut.)
+        #[test]
+        fn power_on_while_driving_in_the_ambiguous_band(
+            load in 2.0_f64..12.0,
+            speed in 2.0_f64..20.0, speed_neg in any::<bool>(),
+            offset in 0.0_f64..16_384.0,
+        ) {
+            let speed = if speed_neg { -speed } else { speed };
+            let load = -speed.signum() * load;
+            let mut plant = Plant::new(load, speed);
+            let along = ambiguous_reading(&plant, load, speed);
+            prop_assume!(along.is_some());
+            let want = along.unwrap_or(load);
+            plant.out_offset = offset;
+            let mut monitor = Monitor::new(Config::default()).unwrap();
+            let trace = run(&mut plant, &mut monitor, speed, 0.3, 1.0);
+            for (_, _, e) in &trace {
+                check_shadow(e)?;
+            }
+            let last = trace.last().unwrap().2;
+            prop_assert_eq!(last.brake, BrakeState::Locked);
+            prop_assert!(!last.flags.any(), "{:?}", last.flags);
+            let hold = last.braking_torque_nm.to_num::<f64>();
+            // At the band's edge (M' near the envelope limit) noise may show the drive-carries
+            // reading first, which is then kept: either consistent reading is right.
+            prop_assert!(
+                (hold - want).abs() <= 0.05 * want.abs() || (hold - load).abs() <= 0.05 * load.abs(),
+                "hold {} vs {} or {}", hold, want, load
+            );
         }
 
         /// Power-on with the drive off anywhere in the envelope (load ±60 N·m, ±50 rad/s): no

@@ -82,6 +82,11 @@ fn exp_neg(x: f64) -> f64 {
     sum
 }
 
+/// How fast the recent peak output speed that widens the innovation limit decays (rad/s per
+/// s): an impact in the lost motion returns at most the speed the output had; after 1 s at
+/// rest the widening is gone even from the 10 rad/s of a typical cut.
+pub const IMPACT_DECAY_RAD_S2: f64 = 10.0;
+
 /// Limits and time constants (SI). Defaults in [`Thresholds::DEFAULT`], with their reasons in
 /// docs/monitor-design.md.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -91,8 +96,6 @@ pub struct Thresholds {
     pub max_load_nm: f64,
     /// Karnopp band and lock detection: |ω_out| below this is "stuck" (rad/s).
     pub stick_speed_rad_s: f64,
-    /// A locked output breaks loose above this speed (rad/s); > stick speed (hysteresis).
-    pub breakaway_speed_rad_s: f64,
     /// Time |ω_out| must stay in the stick band before the pack counts as locked (s).
     pub lock_dwell_s: f64,
     /// Output travel allowed after the brake locked with the drive off (rad): `brake_slip`.
@@ -121,8 +124,6 @@ pub struct Thresholds {
     pub load_filter_hz: f64,
     /// Bandwidth of the input-speed filter (Hz).
     pub input_speed_filter_hz: f64,
-    /// Output faster than input by this much (rad/s), drive on: overrunning.
-    pub overrun_speed_band_rad_s: f64,
     /// Fastest plausible output speed (rad/s): larger encoder steps are a sensor fault.
     pub max_output_speed_rad_s: f64,
     /// Fastest plausible motor speed (rad/s, motor side).
@@ -136,6 +137,9 @@ pub struct Thresholds {
     pub adc_rail_time_s: f64,
     /// Rate at which the pack-health estimate may move (1/s, sign-LMS step).
     pub health_rate_per_s: f64,
+    /// Time over which an impact in the lost motion may reverse the output speed before the
+    /// observer follows (s): widens the innovation limit by `2·|ω̂|·this`.
+    pub impact_time_s: f64,
 }
 
 impl Thresholds {
@@ -143,9 +147,8 @@ impl Thresholds {
     pub const DEFAULT: Thresholds = Thresholds {
         max_load_nm: 60.0,
         stick_speed_rad_s: 0.3,
-        breakaway_speed_rad_s: 1.0,
-        lock_dwell_s: 0.01,
-        creep_limit_rad: 0.02,
+        lock_dwell_s: 0.001,
+        creep_limit_rad: 0.15,
         braking_grace_s: 0.4,
         braking_angle_factor: 2.0,
         braking_angle_allowance_rad: 1.0,
@@ -157,13 +160,13 @@ impl Thresholds {
         engage_settle_s: 0.02,
         load_filter_hz: 10.0,
         input_speed_filter_hz: 200.0,
-        overrun_speed_band_rad_s: 0.5,
         max_output_speed_rad_s: 60.0,
         max_motor_speed_rad_s: 1800.0,
         max_lost_motion_rad: 2.0,
         current_off_max_a: 3.0,
         adc_rail_time_s: 0.002,
         health_rate_per_s: 25.0,
+        impact_time_s: 0.01,
     };
 }
 
@@ -189,6 +192,10 @@ pub struct Config {
     /// Friction coefficient in the pack capacity `T_all`; default μ_s (the paper's levels, see
     /// MODEL.md).
     pub capacity_mu: f64,
+    /// Friction coefficient of the slipping pack while the drive runs (default μ_d): it sets the
+    /// drag while driving and the overrunning equilibrium (docs/monitor-design.md, "physical
+    /// reading").
+    pub sliding_mu: f64,
     /// Factor from motor torque × ratio to output torque when the load back-drives the motor
     /// (power flowing to the motor); default `1/η`. When motoring, `η` is used.
     pub backdrive_efficiency: f64,
@@ -212,6 +219,7 @@ impl Config {
             observer: ObserverGains::triple_pole(DEFAULT_OBSERVER_BANDWIDTH_HZ, DEFAULT_TICK_HZ),
             tick_hz: DEFAULT_TICK_HZ,
             capacity_mu: mechanism.mu_static,
+            sliding_mu: mechanism.mu_dynamic,
             backdrive_efficiency: 1.0 / sensors.reducer_efficiency,
             max_catchup_ticks: 8,
         }
@@ -300,17 +308,21 @@ pub(crate) struct Params {
     pub max_catchup: u8,
     // Pack.
     pub spring_force: Q16,
-    pub spring_drag: Q16,
     pub ramp_factor: Scale<21>,
     pub capacity_per_n: Scale<32>,
-    pub inv_engaged_kappa: Scale<27>,
+    /// Pressing force while driving against the load: `F_s/(1 + μ_d·c·k)` (input ramps unload).
+    pub drive_force: Q16,
+    /// Pack drag while driving against the load: `μ_d·c·F_drive`.
+    pub drive_drag: Q16,
+    /// Overrunning equilibrium (load along the motion, drive on): pack torque
+    /// `y = g₁·v − g₀` for a drive torque `v` along the motion; `g₁ = 2μ_d·c·k/(μ_d·c·k − 1)`.
+    pub overrun_gain: Scale<24>,
+    /// `g₀ = μ_d·c·F_s/(μ_d·c·k − 1)` (N·m).
+    pub overrun_offset: Q16,
     // Thresholds.
     pub max_load: Q16,
     pub min_load: Q16,
     pub stick_speed: Q16,
-    pub breakaway_speed: Q16,
-    pub overrun_band: Q16,
-    pub drag_allowance: Q16,
     pub min_margin: Scale<26>,
     pub lock_dwell_ticks: u32,
     pub persistence_ticks: u32,
@@ -322,7 +334,14 @@ pub(crate) struct Params {
     pub braking_angle_allowance: i32,
     pub speed_to_counts: Scale<28>,
     pub innovation_limit: i32,
+    /// Q16 rad/s → angle words: the prediction error an impact reversing that speed can cause.
+    pub impact_words: Scale<16>,
+    /// Decay of the recent peak speed per tick (Q16 rad/s bits): [`IMPACT_DECAY_RAD_S2`]·h.
+    pub impact_decay: i32,
+    /// Gain of the load filter, run on every other tick.
     pub load_alpha: Gain,
+    /// `T_drive + drag_allowance`: the pack torque above which a driving pack drags.
+    pub drag_limit: Q16,
     pub load_known_ticks: u32,
     pub health_step: i32,
     pub energy_per_tick: Scale<32>,
@@ -461,13 +480,22 @@ impl Params {
                 parameter: "capacity_mu",
             });
         }
-        let kappa = 1.0 - per_n * ramp;
-        // κ ≈ 0 would make the engaged load inversion ill-conditioned.
-        if kappa > -0.05 && kappa < 0.05 {
+        let mu_d = finite(c.sliding_mu, "sliding_mu")?;
+        if !(0.0..=2.0).contains(&mu_d) || mu_d == 0.0 {
             return Err(ConfigError::OutOfRange {
-                parameter: "mechanism.socket_chamfer_rad",
+                parameter: "sliding_mu",
             });
         }
+        // Sliding self-locking ratio a·k = μ_d·c·tanθ/r (1.42 at Table 2): the overrunning
+        // equilibrium divides by a·k − 1, so a·k ≈ 1 is rejected.
+        let a_k = m.pack_torque_per_newton_m(mu_d) * ramp;
+        if a_k > 0.95 && a_k < 1.05 {
+            return Err(ConfigError::OutOfRange {
+                parameter: "sliding_mu",
+            });
+        }
+        let drive_force = spring / (1.0 + a_k);
+        let drive_drag = m.pack_torque_per_newton_m(mu_d) * drive_force;
 
         // --- Sensors.
         let kt = positive(
@@ -589,12 +617,6 @@ impl Params {
 
         // --- Thresholds.
         let stick = positive(t.stick_speed_rad_s, "thresholds.stick_speed_rad_s")?;
-        let breakaway = positive(t.breakaway_speed_rad_s, "thresholds.breakaway_speed_rad_s")?;
-        if breakaway <= stick {
-            return Err(ConfigError::OutOfRange {
-                parameter: "thresholds.breakaway_speed_rad_s",
-            });
-        }
         let min_margin = positive(t.min_capacity_margin, "thresholds.min_capacity_margin")?;
         let alpha = |hz: f64, parameter| -> Result<Gain, ConfigError> {
             let hz = positive(hz, parameter)?;
@@ -633,28 +655,21 @@ impl Params {
             obs,
             max_catchup: c.max_catchup_ticks,
             spring_force: q16(spring, "mechanism.spring_preload_m")?,
-            spring_drag: q16(per_n * spring, "mechanism.spring_preload_m")?,
             ramp_factor: scale(ramp, "mechanism.socket_radius_m")?,
             capacity_per_n: scale(per_n, "capacity_mu")?,
-            inv_engaged_kappa: scale(1.0 / kappa, "mechanism.socket_chamfer_rad")?,
+            drive_force: q16(drive_force, "sliding_mu")?,
+            drive_drag: q16(drive_drag, "sliding_mu")?,
+            overrun_gain: scale(2.0 * a_k / (a_k - 1.0), "sliding_mu")?,
+            overrun_offset: q16(
+                m.pack_torque_per_newton_m(mu_d) * spring / (a_k - 1.0),
+                "sliding_mu",
+            )?,
             max_load: q16(max_load, "thresholds.max_load_nm")?,
             min_load: q16(
                 positive(t.min_load_nm, "thresholds.min_load_nm")?,
                 "thresholds.min_load_nm",
             )?,
             stick_speed: q16(stick, "thresholds.stick_speed_rad_s")?,
-            breakaway_speed: q16(breakaway, "thresholds.breakaway_speed_rad_s")?,
-            overrun_band: q16(
-                positive(
-                    t.overrun_speed_band_rad_s,
-                    "thresholds.overrun_speed_band_rad_s",
-                )?,
-                "thresholds.overrun_speed_band_rad_s",
-            )?,
-            drag_allowance: q16(
-                positive(t.drag_allowance_nm, "thresholds.drag_allowance_nm")?,
-                "thresholds.drag_allowance_nm",
-            )?,
             min_margin: scale(min_margin, "thresholds.min_capacity_margin")?,
             lock_dwell_ticks: ticks(t.lock_dwell_s, tick_hz, "thresholds.lock_dwell_s")?,
             persistence_ticks: ticks(
@@ -686,7 +701,29 @@ impl Params {
             speed_to_counts: scale(h / out_rad, "sensors.output_encoder_bits")?,
             innovation_limit: counts(out_jump, "thresholds.max_output_speed_rad_s")?
                 .saturating_mul(1_i32 << (32 - u32::from(s.output_encoder_bits)).min(30)),
-            load_alpha: alpha(t.load_filter_hz, "thresholds.load_filter_hz")?,
+            impact_words: scale(
+                2.0 * positive(t.impact_time_s, "thresholds.impact_time_s")? * words_per_rad
+                    / Q16_ONE,
+                "thresholds.impact_time_s",
+            )?,
+            // 1e-3 rad/s per tick at 10 kHz, ≥ 1 LSB at any tick rate; `as` is exact here
+            // (0 < value < 2^31 for any accepted tick rate).
+            impact_decay: ((IMPACT_DECAY_RAD_S2 * h * Q16_ONE + 0.5) as i32).max(1),
+            // The load filter runs on every other tick (Monitor::step, "cost"): its gain is
+            // that of a filter sampled at tick_hz/2.
+            load_alpha: gain(
+                1.0 - exp_neg(
+                    core::f64::consts::TAU
+                        * positive(t.load_filter_hz, "thresholds.load_filter_hz")?
+                        * 2.0
+                        * h,
+                ),
+                "thresholds.load_filter_hz",
+            )?,
+            drag_limit: q16(
+                drive_drag + positive(t.drag_allowance_nm, "thresholds.drag_allowance_nm")?,
+                "thresholds.drag_allowance_nm",
+            )?,
             // Three time constants of the load filter (95 %).
             load_known_ticks: ticks(
                 3.0 / (core::f64::consts::TAU

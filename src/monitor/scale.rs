@@ -138,18 +138,23 @@ pub fn recip_q16(x: i32) -> i32 {
     }
     let xu = x as u32; // x > 0
     let n = xu.leading_zeros(); // 1..=31
-    let m = u64::from(xu << n); // f = m / 2^32 ∈ [½, 1)
-    const ONE_Q30: u64 = 1 << 30;
+    let m = xu << n; // f = m / 2^32 ∈ [½, 1)
+    const ONE_Q30: u32 = 1 << 30;
     // y0 = 48/17 − 32/17·f in Q30 (constants folded at compile time: no run-time division).
-    const C48: u64 = (48 * ONE_Q30) / 17;
-    const C32: u64 = (32 * ONE_Q30) / 17;
-    let mut y = C48 - ((C32 * m) >> 32);
+    const C48: u32 = ((48 * ONE_Q30 as u64) / 17) as u32;
+    const C32: u32 = ((32 * ONE_Q30 as u64) / 17) as u32;
+    // Every operand is a u32 and every product u32 × u32 → u64 (one UMULL on Cortex-M3/M4):
+    // y stays in (0, 2^31] (Newton for 1/f approaches from below, and 1/f ≤ 2), so the
+    // narrowing casts below are exact.
+    let wide_mul = |a: u32, b: u32| u64::from(a) * u64::from(b);
+    let mut y = C48 - (wide_mul(C32, m) >> 32) as u32;
     for _ in 0..3 {
-        let fy = (m * y) >> 32; // f·y in Q30, ≈ 2^30
+        let fy = (wide_mul(m, y) >> 32) as u32; // f·y in Q30, ≈ 2^30
         let two_minus = (2 * ONE_Q30).saturating_sub(fy);
-        y = (y * two_minus) >> 30;
+        y = (wide_mul(y, two_minus) >> 30) as u32;
     }
     // 1/x_value = 2^16 · 2^32 / (x·2^16) … in Q16 bits: 2^32/x = 2^n / f = y·2^(n−30).
+    let y = u64::from(y);
     let wide = if n >= 30 {
         y << (n - 30)
     } else {
