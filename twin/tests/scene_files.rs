@@ -76,3 +76,12 @@ fn syntax_and_type_errors_name_the_place() {
 fn hold_has_no_release() {
     assert!(err("[scene]\nkind = \"hold\"\nrelease_at_s = 0.1\n").contains("scene.release_at_s"));
 }
+
+#[test]
+fn nan_infinite_zero_and_negative_parameters_are_named() {
+    let mech = |line: &str| err(&format!("[scene]\nkind = \"hold\"\n[mechanism]\n{line}\n"));
+    assert!(mech("output_inertia_kg_m2 = 0.0").contains("mechanism.output_inertia_kg_m2"));
+    assert!(mech("output_inertia_kg_m2 = -0.15").contains("mechanism.output_inertia_kg_m2"));
+    assert!(mech("mu_static = nan").contains("mechanism.mu_static"));
+    assert!(mech("contact_stiffness = inf").contains("mechanism.contact_stiffness"));
+}
