@@ -254,28 +254,69 @@ pub fn expected_flag(kind: FaultKind) -> &'static [&'static str] {
     }
 }
 
-/// When a fault shows in what the monitor can observe: sensor faults at once; brake-holding
-/// faults when the brake is next asked to hold (drive off at or after the onset); drag when
-/// the drive next runs.
+/// How long the pack must keep slipping with the drive off before a holding fault counts as
+/// manifest (s): a healthy pack in the twin's physical reading locks within 2–10 ms of a cut
+/// (docs/model.md), so a longer slip is the brake failing to hold.
+pub const FAILED_HOLD_SLIP_S: f64 = 0.020;
+
+/// Output-encoder counts the shaft must truly turn before a stuck encoder can be noticed.
+pub const STUCK_VISIBLE_COUNTS: f64 = 2.0;
+
+/// When a fault first changes what the sensors can show — before that no monitor could see it
+/// (a weakened pack that still self-locks is dormant, the case the periodic functional tests of
+/// the field exist for). From the twin's truth columns:
+/// - holding faults (friction_loss, spring_broken, pack_wear, ramp_jam): the start of the first
+///   run, at or after the onset, in which the drive is off and the pack slips for at least
+///   [`FAILED_HOLD_SLIP_S`];
+/// - drag: the first sample at or after the onset with the drive running;
+/// - encoder_jump: at the onset; encoder_stuck: once the true output angle has moved
+///   [`STUCK_VISIBLE_COUNTS`] counts from its value at the onset;
+/// - current_open: the first sample at or after the onset with the drive running (a current is
+///   then expected).
 pub fn manifest_time(fault: &Fault, trace: &Trace) -> Option<f64> {
-    let after = trace.rows.iter().filter(|r| r.t_s >= fault.at_s);
+    let rows = &trace.rows;
+    let start = rows.iter().position(|r| r.t_s >= fault.at_s)?;
+    let after = || rows.iter().skip(start);
     match fault.kind {
-        FaultKind::EncoderStuck | FaultKind::EncoderJump | FaultKind::CurrentOpen => {
-            Some(fault.at_s)
+        FaultKind::EncoderJump => Some(fault.at_s),
+        FaultKind::Drag | FaultKind::CurrentOpen => after().find(|r| r.drive_on).map(|r| r.t_s),
+        FaultKind::EncoderStuck => {
+            let count_rad = std::f64::consts::TAU / 16_384.0;
+            let angle0 = rows.get(start)?.output_angle_rad;
+            after()
+                .find(|r| (r.output_angle_rad - angle0).abs() >= STUCK_VISIBLE_COUNTS * count_rad)
+                .map(|r| r.t_s)
         }
-        FaultKind::Drag => after.clone().find(|r| r.drive_on).map(|r| r.t_s),
-        _ => after.clone().find(|r| !r.drive_on).map(|r| r.t_s),
+        FaultKind::FrictionLoss
+        | FaultKind::SpringBroken
+        | FaultKind::PackWear
+        | FaultKind::RampJam => {
+            let mut run_start: Option<f64> = None;
+            for r in after() {
+                if !r.drive_on && r.brake_state == 1 {
+                    let t0 = *run_start.get_or_insert(r.t_s);
+                    if r.t_s - t0 >= FAILED_HOLD_SLIP_S {
+                        return Some(t0);
+                    }
+                } else {
+                    run_start = None;
+                }
+            }
+            None
+        }
     }
 }
 
-/// Detection latency of a fault (s): first expected flag at or after it manifests.
+/// Detection latency of a fault (s): from its manifesting to the first flag that answers its
+/// kind raised at or after the onset (0 when the flag came first: detected before it could
+/// harm). `None`: never flagged, or never manifest.
 pub fn detection_latency_s(fault: &Fault, trace: &Trace, acc: &Accuracy) -> Option<f64> {
     let at = manifest_time(fault, trace)?;
     acc.flags
         .iter()
         .filter(|f| expected_flag(fault.kind).contains(&f.flag))
-        .map(|f| f.t_s - at)
-        .find(|dt| *dt >= -1e-9)
+        .find(|f| f.t_s >= fault.at_s - 1e-9)
+        .map(|f| (f.t_s - at).max(0.0))
 }
 
 /// Flags raised before the first fault's onset (all of them in a fault-free run), `overrun`

@@ -99,8 +99,9 @@ pub fn main(args: &[String]) -> Result<i32, String> {
             .collect();
         latencies.sort_by(f64::total_cmp);
         let detected = latencies.len();
-        let rate = detected as f64 / manifested.len().max(1) as f64;
-        all_ok &= rate >= DETECTION_TARGET;
+        // No manifested run leaves the target unproven: it counts as not met, shown as "—".
+        let rate = (!manifested.is_empty()).then(|| detected as f64 / manifested.len() as f64);
+        all_ok &= rate.is_some_and(|r| r >= DETECTION_TARGET);
         rows.push(json!({
             "kind": format!("{kind:?}"),
             "runs": runs.len(),
@@ -175,12 +176,14 @@ fn table(r: &serde_json::Value) -> String {
     for row in r["fault_kinds"].as_array().into_iter().flatten() {
         let _ = writeln!(
             s,
-            "| {} | {} | {} | {} | {:.1} % | {} | {} | {} |",
+            "| {} | {} | {} | {} | {} | {} | {} | {} |",
             row["kind"].as_str().unwrap_or(""),
             row["runs"],
             row["manifested"],
             row["detected_within_window"],
-            row["detection_rate"].as_f64().unwrap_or(0.0) * 100.0,
+            row["detection_rate"]
+                .as_f64()
+                .map_or("—".into(), |r| format!("{:.1} %", r * 100.0)),
             fmt_opt(&row["latency_median_s"], 1e3, 1),
             fmt_opt(&row["latency_max_s"], 1e3, 1),
             row["false_alarms_before_onset"],
@@ -234,11 +237,16 @@ fn doc(a: &Args, r: &serde_json::Value) -> String {
          every sensor reading). Any flag in a nominal run is a false alarm.\n\
          - Fault draws: the same plus one fault, onset uniform over the scene, severity \
          0.5–1 (each kind's meaning is in `model.md`).\n\
-         - *Manifesting*: a sensor fault (encoder_stuck, encoder_jump, current_open) at its \
-         onset; a holding fault (friction_loss, spring_broken, pack_wear, ramp_jam) when the \
-         brake is next asked to hold — the first sample at or after the onset with the drive \
-         off; drag when the drive next runs. A fault the scene never exercises is not counted.\n\
-         - *Detected*: a flag that answers the kind rises within {:.0} ms of manifesting \
+         - *Manifesting* (`host_tests::accuracy::manifest_time`, from the twin's truth): a \
+         holding fault (friction_loss, spring_broken, pack_wear, ramp_jam) when, with the drive \
+         off, the pack keeps slipping for 20 ms (a healthy pack locks within 2–10 ms): the brake \
+         is failing to hold; drag and current_open when the drive next runs; encoder_jump at its \
+         onset; encoder_stuck once the shaft has truly turned two counts. A fault that never \
+         manifests in its scene (for instance a weakened pack that still self-locks: dormant, \
+         the case periodic functional tests exist for) is counted in the runs but not in the \
+         rate.\n\
+         - *Detected*: a flag that answers the kind rises after the onset and within {:.0} ms \
+         of manifesting (earlier counts as 0 ms) \
          (holding faults: brake_weak or brake_slip, ramp_jam also brake_drag; drag: \
          brake_drag; sensor faults: sensor_fault). Target: ≥ {:.0} % of manifested runs per \
          kind, and no false alarm in the nominal runs.\n\
