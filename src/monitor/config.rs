@@ -162,7 +162,7 @@ impl Thresholds {
         input_speed_filter_hz: 200.0,
         max_output_speed_rad_s: 60.0,
         max_motor_speed_rad_s: 1800.0,
-        max_lost_motion_rad: 2.0,
+        max_lost_motion_rad: 0.2, // the twin's lost motion is 0.03–0.1 rad
         current_off_max_a: 3.0,
         adc_rail_time_s: 0.002,
         health_rate_per_s: 25.0,
