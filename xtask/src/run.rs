@@ -69,7 +69,7 @@ pub fn fields(line: &str) -> BTreeMap<&str, &str> {
         .collect()
 }
 
-fn field<T: std::str::FromStr>(line: &BTreeMap<&str, &str>, key: &str) -> Result<T, String> {
+pub fn field<T: std::str::FromStr>(line: &BTreeMap<&str, &str>, key: &str) -> Result<T, String> {
     let raw = line
         .get(key)
         .ok_or_else(|| format!("no `{key}=` in the firmware's line"))?;
@@ -92,7 +92,7 @@ fn hex(line: &BTreeMap<&str, &str>, key: &str) -> Result<u32, String> {
 }
 
 /// The line of `lines` whose message starts with `word`.
-fn line_with<'a>(lines: &'a [String], word: &str) -> Result<BTreeMap<&'a str, &'a str>, String> {
+pub fn line_with<'a>(lines: &'a [String], word: &str) -> Result<BTreeMap<&'a str, &'a str>, String> {
     lines
         .iter()
         .find(|l| l.split_whitespace().nth(1) == Some(word))
