@@ -60,8 +60,8 @@ pub fn main(_args: &[String]) -> Result<i32, String> {
             let max: f64 = run::field::<u32>(&line, "ticks_max")?.into();
             let per = core.ticks_per_insn(BENCH_SHIFT);
             let (mean, max) = (sum / steps.max(1.0) / per, max / per);
-            if core == Core::M3 && m3_best.is_none_or(|(_, best)| max < best) {
-                m3_best = Some((level, max));
+            if core == Core::M3 && m3_best.is_none_or(|(_, best)| mean < best) {
+                m3_best = Some((level, mean));
             }
             println!(
                 "{} opt-level={level}: flash {flash} B, {mean:.1} / {max:.0} instructions per step",
@@ -74,13 +74,15 @@ pub fn main(_args: &[String]) -> Result<i32, String> {
             );
         }
     }
-    // Criterion: fewest worst-case instructions per step on the M3 (the budget's reference
-    // core); flash is far below its budget at every level, so size only breaks ties.
+    // Criterion: fewest instructions per step on average on the M3 (the budget's reference
+    // core), the same criterion as the first measurement on the fixed-point self-check; the
+    // worst cases are listed beside it. Flash is far below its budget at every level.
     if let Some((level, insns)) = m3_best {
         let _ = writeln!(
             table,
-            "\nFewest worst-case instructions per step on the M3 (the budget's reference core): \
-             opt-level {level} ({insns:.0}). Flash is far below the 64 KB budget at every level."
+            "\nFewest instructions per step on average on the M3 (the budget's reference core): \
+             opt-level {level} ({insns:.1}); compare the worst cases in the last column before \
+             changing it. Flash is far below the 64 KB budget at every level."
         );
     }
     let out = workspace_root().join("docs").join("results");
