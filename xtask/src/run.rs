@@ -92,7 +92,10 @@ fn hex(line: &BTreeMap<&str, &str>, key: &str) -> Result<u32, String> {
 }
 
 /// The line of `lines` whose message starts with `word`.
-pub fn line_with<'a>(lines: &'a [String], word: &str) -> Result<BTreeMap<&'a str, &'a str>, String> {
+pub fn line_with<'a>(
+    lines: &'a [String],
+    word: &str,
+) -> Result<BTreeMap<&'a str, &'a str>, String> {
     lines
         .iter()
         .find(|l| l.split_whitespace().nth(1) == Some(word))
