@@ -73,6 +73,26 @@ pub fn lowpass(state: Q16, input: Q16, alpha: Gain) -> Q16 {
     Q16::from_bits(i32::try_from(s + step).unwrap_or(state.to_bits()))
 }
 
+/// Clamps an `i64` to `i32`, **saturating**: the last step of every widened fixed-point
+/// product or sum.
+///
+/// ```
+/// use noback::fx::sat_i32;
+/// assert_eq!(sat_i32(1 << 40), i32::MAX);
+/// assert_eq!(sat_i32(-(1 << 40)), i32::MIN);
+/// assert_eq!(sat_i32(-7), -7);
+/// ```
+#[inline(always)]
+pub fn sat_i32(x: i64) -> i32 {
+    if x > i64::from(i32::MAX) {
+        i32::MAX
+    } else if x < i64::from(i32::MIN) {
+        i32::MIN
+    } else {
+        x as i32
+    }
+}
+
 /// `a · b` in [`Q16`], **saturating** at the format's limits (a clipped torque is the safe answer).
 ///
 /// ```

@@ -15,6 +15,7 @@
 //! [`recip_q16`] gives `1/x` in Q16 by Newton–Raphson on a normalised mantissa, so the step
 //! has no division (a software division costs ~100 instructions on Cortex-M0).
 
+pub use crate::fx::sat_i32;
 /// Why a constant does not fit a [`Scale<S>`].
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum ScaleError {
@@ -103,18 +104,6 @@ impl<const S: u32> Scale<S> {
     /// The mantissa (`k = mul · 2^-S`).
     pub const fn mantissa(self) -> i32 {
         self.mul
-    }
-}
-
-/// Clamps an `i64` to `i32`: the saturation every fixed-point result goes through.
-#[inline]
-pub fn sat_i32(x: i64) -> i32 {
-    if x > i64::from(i32::MAX) {
-        i32::MAX
-    } else if x < i64::from(i32::MIN) {
-        i32::MIN
-    } else {
-        x as i32
     }
 }
 

@@ -18,6 +18,7 @@
 //! the step itself uses only [`Real::add`], [`Real::sub`], [`Real::mulk`], comparisons and
 //! [`Widen::widen`].
 
+use crate::fx::sat_i32 as sat32;
 use fixed::types::{I16F16, I32F32};
 
 /// A number format of the reduced model.
@@ -203,18 +204,6 @@ impl KQ16 {
         } else {
             (p + (1_i64 << (self.s - 1))) >> self.s
         }
-    }
-}
-
-/// `i64` to `i32`, saturating.
-#[inline(always)]
-fn sat32(x: i64) -> i32 {
-    if x > i64::from(i32::MAX) {
-        i32::MAX
-    } else if x < i64::from(i32::MIN) {
-        i32::MIN
-    } else {
-        x as i32
     }
 }
 
