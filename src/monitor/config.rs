@@ -151,7 +151,7 @@ impl Thresholds {
         creep_limit_rad: 0.15,
         braking_grace_s: 0.4,
         braking_angle_factor: 2.0,
-        braking_angle_allowance_rad: 1.0,
+        braking_angle_allowance_rad: 0.1, // the twin's healthy pack stops within 0.07 rad
         min_capacity_margin: 1.5,
         min_load_nm: 1.0,
         drag_allowance_nm: 8.0,
