@@ -10,7 +10,8 @@
 //!    (`noback-bench`, `-icount shift=10`), and per simulated second.
 //! 3. The twin itself at several tolerances, both readings, against its tightest run.
 //! 4. The full physical model (`TwinModel::rhs`) with explicit Euler and RK4 at fixed steps from
-//!    0.5 µs up past their stability limit, for several contact stiffnesses: stable, diverged or
+//!    0.5 µs up past their stability limit, varying contact stiffness, the connecting-shaft
+//!    inertia (inertia ratio) and μ one at a time: stable, diverged or
 //!    inaccurate (`bench/explicit.rs`).
 //! 5. The shipped monitor's cost (`cargo xtask run`'s replay on the M3).
 //!
@@ -310,7 +311,10 @@ fn m3_costs(echo: bool) -> Result<Vec<(String, String, f64, f64)>, String> {
 #[derive(Clone, Debug)]
 struct StabRow {
     method: &'static str,
-    stiffness_scale: f64,
+    /// Which parameter is scaled: `k` (contact stiffness), `Jc` (connecting-shaft inertia,
+    /// i.e. the inertia ratio against the output), `mu` (both friction coefficients), or `base`.
+    parameter: &'static str,
+    scale: f64,
     h_us: f64,
     verdict: &'static str,
     diverged_at_s: Option<f64>,
@@ -328,11 +332,34 @@ fn stability(quick: bool) -> Result<Vec<StabRow>, String> {
     } else {
         &[0.5, 1.0, 2.0, 2.5, 4.0, 5.0, 10.0, 20.0]
     };
-    let stiff: &[f64] = if quick { &[1.0] } else { &[0.25, 1.0, 4.0] };
+    // What makes the full model stiff or soft: contact stiffness, the light connecting shaft
+    // against the output (inertia ratio), and friction. One factor at a time around Table 2.
+    let variations: &[(&'static str, f64)] = if quick {
+        &[("base", 1.0)]
+    } else {
+        &[
+            ("base", 1.0),
+            ("k", 0.25),
+            ("k", 4.0),
+            ("Jc", 0.25),
+            ("Jc", 4.0),
+            ("mu", 0.5),
+            ("mu", 1.5),
+        ]
+    };
     let mut rows = Vec::new();
-    for &ks in stiff {
+    for &(parameter, ks) in variations {
         let mut scene = Scene::builtin(SceneKind::ReverseLoad, Reading::Physical);
-        scene.mechanism.contact_stiffness *= ks;
+        let m = &mut scene.mechanism;
+        match parameter {
+            "k" => m.contact_stiffness *= ks,
+            "Jc" => m.connecting_inertia_kg_m2 *= ks,
+            "mu" => {
+                m.mu_static *= ks;
+                m.mu_dynamic *= ks;
+            }
+            _ => {}
+        }
         scene.duration_s = window;
         scene.tolerance = 1e-8;
         let reference = run_model(&scene, Physical::new(model_config(&scene)))
@@ -365,12 +392,13 @@ fn stability(quick: bool) -> Result<Vec<StabRow>, String> {
                     }
                 };
                 eprintln!(
-                    "bench: stability {} k×{ks} h={h} µs: {verdict}",
+                    "bench: stability {} {parameter}×{ks} h={h} µs: {verdict}",
                     method.name()
                 );
                 rows.push(StabRow {
                     method: method.name(),
-                    stiffness_scale: ks,
+                    parameter,
+                    scale: ks,
                     h_us: h,
                     verdict,
                     diverged_at_s: at,
@@ -487,7 +515,14 @@ fn chart(
 fn stability_chart(path: &std::path::Path, rows: &[StabRow]) -> Result<(), String> {
     use plotters::prelude::*;
     let e = |x: DrawingAreaErrorKind<_>| format!("chart: {x:?}");
-    let root = SVGBackend::new(path, (800, 420)).into_drawing_area();
+    let mut lanes: Vec<(&str, &str, f64)> = Vec::new();
+    for r in rows {
+        if !lanes.contains(&(r.method, r.parameter, r.scale)) {
+            lanes.push((r.method, r.parameter, r.scale));
+        }
+    }
+    let height = 120 + 28 * lanes.len() as u32;
+    let root = SVGBackend::new(path, (800, height)).into_drawing_area();
     root.fill(&WHITE).map_err(e)?;
     let mut c = ChartBuilder::on(&root)
         .caption(
@@ -497,31 +532,25 @@ fn stability_chart(path: &std::path::Path, rows: &[StabRow]) -> Result<(), Strin
         .margin(12)
         .x_label_area_size(40)
         .y_label_area_size(90)
-        .build_cartesian_2d((0.3_f64..40.0).log_scale(), 0.0_f64..7.0)
+        .build_cartesian_2d((0.08_f64..40.0).log_scale(), 0.0_f64..lanes.len() as f64 + 1.0)
         .map_err(e)?;
     c.configure_mesh()
         .x_desc("step (µs)")
-        .y_desc("method, contact stiffness ×")
+        .y_desc("method, parameter × scale")
         .y_labels(0)
         .draw()
         .map_err(e)?;
-    let mut lanes: Vec<(&str, f64)> = Vec::new();
-    for r in rows {
-        if !lanes.contains(&(r.method, r.stiffness_scale)) {
-            lanes.push((r.method, r.stiffness_scale));
-        }
-    }
     for (li, lane) in lanes.iter().enumerate() {
         let y = li as f64 + 0.5;
         c.draw_series(std::iter::once(Text::new(
-            format!("{} k×{}", lane.0, lane.1),
-            (0.32, y + 0.2),
+            format!("{} {}×{}", lane.0, lane.1, lane.2),
+            (0.085, y + 0.2),
             ("sans-serif", 12),
         )))
         .map_err(e)?;
         for r in rows
             .iter()
-            .filter(|r| (r.method, r.stiffness_scale) == *lane)
+            .filter(|r| (r.method, r.parameter, r.scale) == *lane)
         {
             let col = match r.verdict {
                 "stable" => GREEN,
@@ -702,14 +731,15 @@ pub fn main(args: &[String]) -> Result<i32, String> {
     std::fs::write(dir.join("speed-accuracy.csv"), &csv).map_err(|e| e.to_string())?;
 
     let mut scsv = String::from(
-        "method,contact_stiffness_scale,step_us,verdict,diverged_at_s,speed_rms_rad_s,rhs_evals\n",
+        "method,parameter,scale,step_us,verdict,diverged_at_s,speed_rms_rad_s,rhs_evals\n",
     );
     for r in &stab {
         let _ = writeln!(
             scsv,
-            "{},{},{},{},{},{},{}",
+            "{},{},{},{},{},{},{},{}",
             r.method,
-            r.stiffness_scale,
+            r.parameter,
+            r.scale,
             r.h_us,
             r.verdict,
             opt(r.diverged_at_s),
@@ -803,7 +833,7 @@ pub fn main(args: &[String]) -> Result<i32, String> {
             serde_json::json!({
                 "variants": vs, "pareto_reverse_load": front_labels,
                 "cheapest": cheapest_rows, "shipped_insns_per_step": shipped_insns,
-                "stability": stab.iter().map(|r| serde_json::json!({"method": r.method, "k_scale": r.stiffness_scale, "h_us": r.h_us, "verdict": r.verdict})).collect::<Vec<_>>(),
+                "stability": stab.iter().map(|r| serde_json::json!({"method": r.method, "parameter": r.parameter, "scale": r.scale, "h_us": r.h_us, "verdict": r.verdict})).collect::<Vec<_>>(),
                 "seconds": t0.elapsed().as_secs_f64(),
             })
         );
@@ -841,8 +871,8 @@ pub fn main(args: &[String]) -> Result<i32, String> {
         println!("\nstability (full physical model, explicit fixed steps):");
         for r in &stab {
             println!(
-                "  {:<5} k×{:<5} h={:>5} µs  {}",
-                r.method, r.stiffness_scale, r.h_us, r.verdict
+                "  {:<5} {:>4}×{:<5} h={:>5} µs  {}",
+                r.method, r.parameter, r.scale, r.h_us, r.verdict
             );
         }
         println!("\ncheapest per scene:");
