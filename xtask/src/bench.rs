@@ -16,7 +16,7 @@
 //! 5. The shipped monitor's cost (`cargo xtask run`'s replay on the M3).
 //!
 //! Writes `docs/results/speed-accuracy.csv` and `.svg`, `docs/results/stability.csv` and
-//! `.svg`, `docs/results/cheapest-per-scene.md`.
+//! `.svg`, `docs/results/cheapest-per-scene.md`, `docs/results/cost-by-core.md`.
 
 pub mod explicit;
 
@@ -251,9 +251,9 @@ impl Variant {
     }
 }
 
-/// M3 instructions per step of every format × integrator, from `noback-bench` under QEMU.
-fn m3_costs(echo: bool) -> Result<Vec<(String, String, f64, f64)>, String> {
-    let core = Core::M3;
+/// Instructions per step (mean, max) of every format × integrator on `core`, from
+/// `noback-bench` under QEMU.
+fn core_costs(core: Core, echo: bool) -> Result<Vec<(String, String, f64, f64)>, String> {
     shell::run(cargo().args([
         "build",
         "--release",
@@ -597,7 +597,9 @@ pub fn main(args: &[String]) -> Result<i32, String> {
     ];
 
     eprintln!("bench: M3 instruction counts under QEMU (noback-bench)");
-    let m3 = m3_costs(false)?;
+    let m3 = core_costs(Core::M3, false)?;
+    eprintln!("bench: Cortex-M0 instruction counts (noback-bench under QEMU)");
+    let m0 = core_costs(Core::M0, false)?;
     let m3_of = |f: &str, m: &str| m3.iter().find(|(a, b, _, _)| a == f && b == m).map(|x| x.2);
     eprintln!("bench: the shipped monitor (cargo xtask run's replay, M3)");
     let (shipped, _) = crate::run::replay_report("reverse_load", Core::M3, None, None, false)?;
@@ -810,6 +812,24 @@ pub fn main(args: &[String]) -> Result<i32, String> {
     );
     std::fs::write(dir.join("cheapest-per-scene.md"), &md).map_err(|e| e.to_string())?;
 
+    // Cost by core: the format that is cheap on an M3 (single-cycle 32×32→64 multiply) is not
+    // necessarily cheap on an M0 (no long multiply, no FPU).
+    let mut cores_md = String::from(
+        "# Instructions per step by core\n\nWritten by `cargo xtask bench`; do not edit. \
+         `noback-bench` under QEMU `-icount` (reverse-load braking, 3000 steps each).\n\n\
+         | format | integrator | M3 mean | M3 max | M0 mean | M0 max | M0 / M3 |\n|---|---|---|---|---|---|---|\n",
+    );
+    for (f, m, mean3, max3) in &m3 {
+        if let Some((_, _, mean0, max0)) = m0.iter().find(|(a, b, _, _)| a == f && b == m) {
+            let _ = writeln!(
+                cores_md,
+                "| {f} | {m} | {mean3:.0} | {max3:.0} | {mean0:.0} | {max0:.0} | {:.1} |",
+                mean0 / mean3.max(1.0)
+            );
+        }
+    }
+    std::fs::write(dir.join("cost-by-core.md"), &cores_md).map_err(|e| e.to_string())?;
+
     if json {
         let vs: Vec<_> = variants
             .iter()
@@ -881,7 +901,7 @@ pub fn main(args: &[String]) -> Result<i32, String> {
         }
         println!("shipped monitor: {shipped_insns:.1} M3 insns/step");
         println!(
-            "\nwrote docs/results/speed-accuracy.{{csv,svg}}, stability.{{csv,svg}}, cheapest-per-scene.md in {:.0} s",
+            "\nwrote docs/results/speed-accuracy.{{csv,svg}}, stability.{{csv,svg}}, cheapest-per-scene.md, cost-by-core.md in {:.0} s",
             t0.elapsed().as_secs_f64()
         );
     }
