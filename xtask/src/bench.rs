@@ -5,8 +5,8 @@
 //!    step, so this isolates the error of format, integrator and rate.
 //! 2. Every format × integrator × rate of the reduced model on `reverse_load` and
 //!    `forward_load`: output-angle and speed RMS, pressing-force RMS (% of the loaded force),
-//!    braking-torque RMS, lock-time error; host ns per step (median of repeated timed runs,
-//!    `std::time::Instant`, not criterion); Cortex-M3 instructions per step under QEMU
+//!    braking-torque RMS, lock-time error; host ns per step (criterion,
+//!    `host-tests/benches/reduced_step.rs`); Cortex-M3 instructions per step under QEMU
 //!    (`noback-bench`, `-icount shift=10`), and per simulated second.
 //! 3. The twin itself at several tolerances, both readings, against its tightest run.
 //! 4. The full physical model (`TwinModel::rhs`) with explicit Euler and RK4 at fixed steps from
@@ -139,32 +139,37 @@ fn run_reduced_by_name(
     }
 }
 
-/// Host nanoseconds per step: the median over `reps` timed runs of 10 000 steps.
-fn host_ns_per_step(fmt: &str, method: Method, reps: usize) -> f64 {
-    fn time<N: Real + Widen<A>, A: Real>(method: Method) -> f64 {
-        let p = Params::from_mechanism(&TABLE2, TABLE2.load_torque_nm, 10_000.0);
-        let mut m = Reduced::<N, A>::new(p, method);
-        m.set_drive(true, BrakingScene::REVERSE.speed_ref_rad_s);
-        m.step();
-        m.set_drive(false, 0.0);
-        let start = Instant::now();
-        for _ in 0..10_000 {
-            m.step();
-            std::hint::black_box(&m);
-        }
-        start.elapsed().as_nanos() as f64 / 1e4
-    }
-    let mut v: Vec<f64> = (0..reps)
-        .map(|_| match fmt {
-            "f64" => time::<f64, f64>(method),
-            "f32" => time::<f32, f32>(method),
-            "I16F16" => time::<I16F16, I16F16>(method),
-            "I32F32" => time::<I32F32, I32F32>(method),
-            _ => time::<I16F16, I32F32>(method),
-        })
-        .collect();
-    v.sort_by(f64::total_cmp);
-    v.get(v.len() / 2).copied().unwrap_or(f64::NAN)
+/// Runs the criterion benchmark `host-tests/benches/reduced_step.rs` (host nanoseconds per
+/// step of every format × integrator).
+fn run_criterion() -> Result<(), String> {
+    shell::run(cargo().args([
+        "bench",
+        "-p",
+        "host-tests",
+        "--bench",
+        "reduced_step",
+        "--",
+        "--noplot",
+    ]))
+}
+
+/// Criterion's mean estimate of one variant (ns per step), from its `estimates.json`.
+fn criterion_ns(fmt: &str, method: Method) -> Result<f64, String> {
+    let dir = if fmt == "I16F16+I32F32" { "mixed" } else { fmt };
+    let path = workspace_root()
+        .join("target")
+        .join("criterion")
+        .join("reduced_step")
+        .join(dir)
+        .join(method.name())
+        .join("new")
+        .join("estimates.json");
+    let text = std::fs::read_to_string(&path).map_err(|e| format!("{}: {e}", path.display()))?;
+    let v: serde_json::Value =
+        serde_json::from_str(&text).map_err(|e| format!("{}: {e}", path.display()))?;
+    v["mean"]["point_estimate"]
+        .as_f64()
+        .ok_or_else(|| format!("{}: no mean.point_estimate", path.display()))
 }
 
 /// Lock time after `release` (s): the first recorded instant after the last one at or above
@@ -671,13 +676,15 @@ pub fn main(args: &[String]) -> Result<i32, String> {
         }
     }
     // The reduced model.
+    eprintln!("bench: host ns per step (criterion, host-tests/benches/reduced_step.rs)");
+    run_criterion()?;
     let total = FORMATS.len() * Method::ALL.len();
     let mut done = 0;
     for fmt in FORMATS {
         for method in Method::ALL {
             done += 1;
             eprintln!("bench: reduced {fmt} {} ({done}/{total})", method.name());
-            let ns = host_ns_per_step(fmt, method, reps);
+            let ns = criterion_ns(fmt, method)?;
             for (name, bs, reference) in &refs {
                 for rate in RATES {
                     let rows = run_reduced_by_name(fmt, method, *bs, rate, 1.0);
