@@ -10,20 +10,21 @@ use noback::reduced::{BrakingScene, Method, Params, Reduced};
 use std::hint::black_box;
 use std::time::Duration;
 
-
 fn one<N: Real + Widen<A>, A: Real>(c: &mut Criterion, format: &str, method: Method) {
     let p = Params::from_mechanism(&TABLE2, TABLE2.load_torque_nm, 10_000.0);
     let mut m = Reduced::<N, A>::new(p, method);
     m.set_drive(true, BrakingScene::REVERSE.speed_ref_rad_s);
     m.step();
     m.set_drive(false, 0.0);
-    c.benchmark_group("reduced_step")
-        .bench_function(BenchmarkId::new(format, method.name()), |b| {
+    c.benchmark_group("reduced_step").bench_function(
+        BenchmarkId::new(format, method.name()),
+        |b| {
             b.iter(|| {
                 m.step();
                 black_box(&m);
             })
-        });
+        },
+    );
 }
 
 fn all(c: &mut Criterion) {
