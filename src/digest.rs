@@ -35,13 +35,6 @@ impl Fnv1a {
         }
     }
 
-    /// Folds every word of a slice in.
-    pub fn push_all(&mut self, words: &[u32]) {
-        for &w in words {
-            self.push(w);
-        }
-    }
-
     /// The digest so far.
     pub const fn value(&self) -> u32 {
         self.0

@@ -138,7 +138,7 @@ mod target {
             sum += u64::from(ticks);
             max = max.max(ticks);
             steps += 1;
-            digest.push_all(&estimate.to_words());
+            digest.push(noback::app::estimate_checksum(&estimate));
         }
         defmt::info!(
             "bench steps={=u32} ticks_sum={=u64} ticks_max={=u32} overhead={=u32} stack_bytes={=u32} digest={=u32:#010x}",
