@@ -95,3 +95,31 @@ fn ci_runs_the_readme_test_command() {
         ".ci/run must run `cargo xtask test`"
     );
 }
+
+#[test]
+fn docs_name_only_commands_the_xtask_has() {
+    let mut pages = Vec::new();
+    let docs = workspace_root().join("docs");
+    for dir in [docs.clone(), docs.join("results")] {
+        for entry in std::fs::read_dir(&dir).into_iter().flatten().flatten() {
+            if entry.path().extension().is_some_and(|e| e == "md") {
+                pages.push(entry.path());
+            }
+        }
+    }
+    assert!(!pages.is_empty());
+    for page in pages {
+        let text = std::fs::read_to_string(&page).unwrap_or_default();
+        for rest in text.split("cargo xtask ").skip(1) {
+            let word = rest
+                .split(|c: char| !c.is_ascii_alphanumeric() && c != '-')
+                .next()
+                .unwrap_or("");
+            assert!(
+                word.is_empty() || crate::COMMANDS.iter().any(|(name, _)| *name == word),
+                "{} names `cargo xtask {word}`, which the xtask does not have",
+                page.display()
+            );
+        }
+    }
+}
