@@ -1,6 +1,6 @@
 //! Speed benchmark (issue 3 §9): times each paper scene of the `physical` reading and, in the
 //! same run, the independent scipy `solve_ivp(method="Radau")` solve of the same equations
-//! (`twin/bench/radau.py`) at the same tolerance, and prints the ratio.
+//! (`bench/radau.py`) at the same tolerance, and prints the ratio.
 //!
 //! `cargo run --release -p noback-twin --example bench -- [--tolerance TOL] [--no-scipy]`
 use noback_twin::metrics;
@@ -17,7 +17,7 @@ fn main() {
         .and_then(|v| v.parse::<f64>().ok())
         .unwrap_or(1e-5);
     let scipy = !args.iter().any(|a| a == "--no-scipy");
-    let script = concat!(env!("CARGO_MANIFEST_DIR"), "/bench/radau.py");
+    let script = concat!(env!("CARGO_MANIFEST_DIR"), "/../bench/radau.py");
     println!("| scene | twin wall (s) | twin RHS evals | twin braking time / angle | scipy Radau wall (s) | scipy RHS evals | scipy braking time / angle | ratio |");
     println!("|---|---|---|---|---|---|---|---|");
     for kind in [

@@ -1,6 +1,6 @@
 //! `cargo xtask twin-bench [--tolerance TOL] [--no-scipy]` — the twin's speed on each paper
 //! scene (release build) against an independent solve of the same equations with scipy's
-//! `solve_ivp(method="Radau")` (`twin/bench/radau.py`), in the same run, at the same tolerance.
+//! `solve_ivp(method="Radau")` (`bench/radau.py`), in the same run, at the same tolerance.
 //! Installs scipy with pip when it is missing (and says so). Writes
 //! `docs/results/twin-speed.md`.
 
