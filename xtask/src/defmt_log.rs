@@ -1,48 +1,62 @@
 //! Decoding the defmt byte stream QEMU writes to stdout (semihosting) into readable lines.
 //!
 //! The `defmt-decoder` crate does the work inside the xtask, so no `defmt-print` needs
-//! installing. Lines are printed as they are decoded and also kept for callers that check them.
+//! installing. [`LogTable`] owns what the ELF says (format strings, source locations);
+//! [`LogDecoder`] borrows it for one run and turns bytes into lines as they arrive.
 
-use defmt_decoder::{DecodeError, Locations, Table};
+use defmt_decoder::{DecodeError, Locations, StreamDecoder, Table};
 
-/// Turns bytes into decoded log lines, frame by frame.
-pub struct LogDecoder {
-    table: &'static Table,
+/// The defmt table and source locations of one ELF image.
+pub struct LogTable {
+    table: Table,
     locations: Option<Locations>,
-    decoder: Box<dyn defmt_decoder::StreamDecoder + Send + Sync + 'static>,
-    /// Bytes that could not be decoded (a sign of a corrupt stream).
-    pub malformed: usize,
 }
 
-impl LogDecoder {
+impl LogTable {
     /// Reads the defmt table from an ELF image.
-    pub fn from_elf(elf: &[u8]) -> Result<LogDecoder, String> {
+    pub fn from_elf(elf: &[u8]) -> Result<LogTable, String> {
         let table = Table::parse(elf)
             .map_err(|e| format!("reading the defmt table: {e}"))?
             .ok_or("the ELF has no defmt table (was it built with -Tdefmt.x?)")?;
         let locations = table.get_locations(elf).ok().filter(|l| !l.is_empty());
-        // The table must outlive the stream decoder that borrows it; one table per process run.
-        let table: &'static Table = Box::leak(Box::new(table));
-        Ok(LogDecoder {
-            table,
-            locations,
-            decoder: table.new_stream_decoder(),
-            malformed: 0,
-        })
+        Ok(LogTable { table, locations })
     }
 
-    /// Feeds received bytes; returns the lines decoded so far.
+    /// A stream decoder over this table.
+    pub fn decoder(&self) -> LogDecoder<'_> {
+        LogDecoder {
+            log: self,
+            stream: self.table.new_stream_decoder(),
+            malformed: 0,
+        }
+    }
+}
+
+/// Turns bytes into decoded log lines, frame by frame.
+pub struct LogDecoder<'t> {
+    log: &'t LogTable,
+    stream: Box<dyn StreamDecoder + Send + Sync + 't>,
+    /// Frames that could not be decoded (a sign of a corrupt stream).
+    pub malformed: usize,
+}
+
+impl LogDecoder<'_> {
+    /// Feeds received bytes; returns the lines decoded so far. Error frames carry their source
+    /// location on a second line when the ELF has it.
     pub fn feed(&mut self, bytes: &[u8]) -> Vec<String> {
-        self.decoder.received(bytes);
+        self.stream.received(bytes);
         let mut lines = Vec::new();
         loop {
-            match self.decoder.decode() {
+            match self.stream.decode() {
                 Ok(frame) => {
                     let mut line = frame.display(false).to_string();
                     let is_error = frame.level().is_some_and(|l| format!("{l:?}") == "Error");
                     if is_error {
-                        if let Some(loc) =
-                            self.locations.as_ref().and_then(|l| l.get(&frame.index()))
+                        if let Some(loc) = self
+                            .log
+                            .locations
+                            .as_ref()
+                            .and_then(|l| l.get(&frame.index()))
                         {
                             line.push_str(&format!("\n└─ {}:{}", loc.file.display(), loc.line));
                         }
@@ -52,7 +66,7 @@ impl LogDecoder {
                 Err(DecodeError::UnexpectedEof) => break,
                 Err(DecodeError::Malformed) => {
                     self.malformed += 1;
-                    if !self.table.encoding().can_recover() {
+                    if !self.log.table.encoding().can_recover() {
                         break;
                     }
                 }

@@ -6,7 +6,7 @@
 //! would otherwise exit 0.
 
 use crate::cores::Core;
-use crate::defmt_log::LogDecoder;
+use crate::defmt_log::LogTable;
 use std::io::Read;
 use std::process::{Command, Stdio};
 use std::sync::mpsc;
@@ -71,7 +71,8 @@ pub fn icount(shift: u32) -> Vec<String> {
 /// Boots an image and decodes its log.
 pub fn boot(boot: &Boot<'_>) -> Result<Outcome, String> {
     let elf_bytes = std::fs::read(boot.elf).map_err(|e| format!("reading {}: {e}", boot.elf))?;
-    let mut decoder = LogDecoder::from_elf(&elf_bytes)?;
+    let log_table = LogTable::from_elf(&elf_bytes)?;
+    let mut decoder = log_table.decoder();
     let mut child = command(boot.core, boot.elf, &boot.extra, &boot.args)
         .stdin(Stdio::null())
         .stdout(Stdio::piped())
