@@ -279,7 +279,7 @@ fn core_costs(core: Core, echo: bool) -> Result<Vec<(String, String, f64, f64)>,
     let out = qemu::boot(&Boot {
         elf: &elf,
         core,
-        timeout: crate::test::BOOT_TIMEOUT,
+        timeout: qemu::BOOT_TIMEOUT,
         extra: qemu::icount(shift),
         echo,
         args: Vec::new(),

@@ -12,6 +12,9 @@ use std::process::{Command, Stdio};
 use std::sync::mpsc;
 use std::time::{Duration, Instant};
 
+/// How long one firmware boot may take before it counts as hung.
+pub const BOOT_TIMEOUT: Duration = Duration::from_secs(60);
+
 /// Exit code for a run that QEMU did not finish in time.
 pub const EXIT_TIMEOUT: i32 = 124;
 

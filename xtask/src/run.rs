@@ -9,10 +9,11 @@
 //! flash, RAM, stack, and whether the firmware's estimates equal the host's bit for bit.
 
 use crate::cores::Core;
+use crate::qemu::BOOT_TIMEOUT;
 use crate::qemu::{self, Boot, Outcome};
 use crate::replay::{host_run, nbr1, stress_trace, twin_trace, STRESS};
 use crate::shell::{self, cargo, workspace_root};
-use crate::{bootstrap, elf_size, test::BOOT_TIMEOUT};
+use crate::{bootstrap, elf_size};
 use noback::monitor::Flags;
 use serde_json::json;
 use std::collections::BTreeMap;

@@ -315,9 +315,6 @@ pub fn digest_in(lines: &[String]) -> Result<u32, String> {
         .ok_or_else(|| "no `fx-selfcheck … digest=0x…` line in the target's log".into())
 }
 
-/// How long one QEMU boot may take before it counts as hung.
-pub const BOOT_TIMEOUT: Duration = Duration::from_secs(60);
-
 #[cfg(test)]
 mod tests {
     use super::*;
