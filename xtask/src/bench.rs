@@ -259,22 +259,7 @@ impl Variant {
 /// Instructions per step (mean, max) of every format × integrator on `core`, from
 /// `noback-bench` under QEMU.
 fn core_costs(core: Core, echo: bool) -> Result<Vec<(String, String, f64, f64)>, String> {
-    shell::run(cargo().args([
-        "build",
-        "--release",
-        "-p",
-        "noback",
-        "--bin",
-        "noback-bench",
-        "--target",
-        core.triple(),
-    ]))?;
-    let elf = workspace_root()
-        .join("target")
-        .join(core.triple())
-        .join("release")
-        .join("noback-bench");
-    let elf = elf.to_string_lossy().into_owned();
+    let elf = crate::run::build_bin("noback-bench", core, None, &[])?;
     let shift = crate::run::BENCH_SHIFT;
     let out = qemu::boot(&Boot {
         elf: &elf,
@@ -287,7 +272,6 @@ fn core_costs(core: Core, echo: bool) -> Result<Vec<(String, String, f64, f64)>,
     if out.code != 0 {
         return Err(format!("noback-bench exited with code {}", out.code));
     }
-    let per = core.ticks_per_insn(shift);
     let mut v = Vec::new();
     for line in out
         .lines
@@ -296,15 +280,8 @@ fn core_costs(core: Core, echo: bool) -> Result<Vec<(String, String, f64, f64)>,
     {
         let f = crate::run::fields(line);
         let get = |k: &str| f.get(k).copied().unwrap_or("");
-        let steps: f64 = get("steps").parse().map_err(|_| "bad steps")?;
-        let sum: f64 = get("ticks_sum").parse().map_err(|_| "bad ticks_sum")?;
-        let max: f64 = get("ticks_max").parse().map_err(|_| "bad ticks_max")?;
-        v.push((
-            get("fmt").to_string(),
-            get("method").to_string(),
-            sum / steps.max(1.0) / per,
-            max / per,
-        ));
+        let (mean, max) = crate::run::step_insns(&f, core)?;
+        v.push((get("fmt").to_string(), get("method").to_string(), mean, max));
     }
     if !out.lines.iter().any(|l| l.contains("bench-done")) {
         return Err("noback-bench did not finish".into());

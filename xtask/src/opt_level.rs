@@ -8,7 +8,7 @@
 use crate::cores::Core;
 use crate::replay::{nbr1, twin_trace};
 use crate::run::{self, BENCH_SHIFT};
-use crate::shell::{self, cargo, workspace_root};
+use crate::shell::workspace_root;
 use crate::{bootstrap, elf_size};
 use std::fmt::Write as _;
 
@@ -40,26 +40,21 @@ pub fn main(_args: &[String]) -> Result<i32, String> {
                 .join("target")
                 .join("opt-level")
                 .join(level);
-            shell::run(
-                cargo()
-                    .args(["build", "--release", "-p", "noback", "--bin", "noback-fw"])
-                    .args(["--target", core.triple(), "--target-dir"])
-                    .arg(&dir)
-                    .env("CARGO_PROFILE_RELEASE_OPT_LEVEL", level)
-                    .env("NOBACK_REPLAY", &replay),
+            let elf = run::build_bin(
+                "noback-fw",
+                core,
+                Some(&dir),
+                &[
+                    ("CARGO_PROFILE_RELEASE_OPT_LEVEL", level.as_ref()),
+                    ("NOBACK_REPLAY", replay.as_os_str()),
+                ],
             )?;
-            let elf = dir.join(core.triple()).join("release").join("noback-fw");
-            let elf = elf.to_string_lossy();
             let flash = elf_size::of_file(&elf)?
                 .flash_bytes
                 .saturating_sub(bytes.len() as u64);
             let out = run::boot(core, &elf, BENCH_SHIFT, vec!["bench".into()], false)?;
             let line = run::line_with(&out.lines, "bench")?;
-            let steps: f64 = run::field::<u32>(&line, "steps")?.into();
-            let sum = run::field::<u64>(&line, "ticks_sum")? as f64;
-            let max: f64 = run::field::<u32>(&line, "ticks_max")?.into();
-            let per = core.ticks_per_insn(BENCH_SHIFT);
-            let (mean, max) = (sum / steps.max(1.0) / per, max / per);
+            let (mean, max) = run::step_insns(&line, core)?;
             if core == Core::M3 && m3_best.is_none_or(|(_, best)| mean < best) {
                 m3_best = Some((level, mean));
             }

@@ -195,12 +195,7 @@ pub fn replay_report(
     let bit_exact = fw_digest == host.totals.digest && bench_digest == host_plain.totals.digest;
 
     let ticks: u32 = field(&summary, "ticks")?;
-    let steps: f64 = field::<u32>(&bench_line, "steps")?.into();
-    let ticks_sum: f64 = field::<u64>(&bench_line, "ticks_sum")? as f64;
-    let ticks_max: f64 = field::<u32>(&bench_line, "ticks_max")?.into();
-    let per_insn = core.ticks_per_insn(BENCH_SHIFT);
-    let insns_mean = ticks_sum / steps.max(1.0) / per_insn;
-    let insns_max = ticks_max / per_insn;
+    let (insns_mean, insns_max) = step_insns(&bench_line, core)?;
     let size = elf_size::of_file(&elf)?;
     let flash_bytes = size.flash_bytes.saturating_sub(bytes.len() as u64);
     let stack_bytes: u32 = field(&summary, "stack_bytes")?;
@@ -320,18 +315,42 @@ fn print_summary(r: &serde_json::Value) {
 
 /// Builds the firmware for `core` in release with `replay` embedded; returns the ELF path.
 pub fn build(core: Core, replay: &std::path::Path) -> Result<String, String> {
+    build_bin(
+        "noback-fw",
+        core,
+        None,
+        &[("NOBACK_REPLAY", replay.as_os_str())],
+    )
+}
+
+/// Builds a target binary of the `noback` package in release for `core` (into `target_dir`,
+/// `target/` by default) with extra environment; returns the ELF path.
+pub fn build_bin(
+    bin: &str,
+    core: Core,
+    target_dir: Option<&std::path::Path>,
+    envs: &[(&str, &std::ffi::OsStr)],
+) -> Result<String, String> {
+    let dir = target_dir.map_or_else(|| workspace_root().join("target"), std::path::PathBuf::from);
     shell::run(
         cargo()
-            .args(["build", "--release", "-p", "noback", "--bin", "noback-fw"])
-            .args(["--target", core.triple()])
-            .env("NOBACK_REPLAY", replay),
+            .args(["build", "--release", "-p", "noback", "--bin", bin])
+            .args(["--target", core.triple(), "--target-dir"])
+            .arg(&dir)
+            .envs(envs.iter().copied()),
     )?;
-    let elf = workspace_root()
-        .join("target")
-        .join(core.triple())
-        .join("release")
-        .join("noback-fw");
+    let elf = dir.join(core.triple()).join("release").join(bin);
     Ok(elf.to_string_lossy().into_owned())
+}
+
+/// Mean and largest instructions per step from a bench line's `steps`, `ticks_sum` and
+/// `ticks_max` (SysTick ticks under `-icount shift=BENCH_SHIFT` on `core`).
+pub fn step_insns(line: &BTreeMap<&str, &str>, core: Core) -> Result<(f64, f64), String> {
+    let steps: f64 = field::<u32>(line, "steps")?.into();
+    let sum = field::<u64>(line, "ticks_sum")? as f64;
+    let max: f64 = field::<u32>(line, "ticks_max")?.into();
+    let per = core.ticks_per_insn(BENCH_SHIFT);
+    Ok((sum / steps.max(1.0) / per, max / per))
 }
 
 /// Boots the firmware once.
