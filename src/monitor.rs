@@ -35,6 +35,13 @@
 //! | `FaultBraking` | drive off, output moving | both socket faces clamp: `F = F_s + k·|T|`, `T` measured; time/angle envelope |
 //! | `Holding` | drive off, stopped 1 ms or reversed by an impact | `T = M̂`; creep-span check |
 //!
+//! Each scene runs the cheapest model that meets the accuracy targets
+//! (docs/results/cheapest-per-scene.md, `cargo xtask bench`; [`Monitor::scene_model`]): no
+//! state in `Driving`, `Holding` and `Overrunning` (quasi-static), and in `FaultBraking` the
+//! nominal braking model of the envelope, stepped by explicit Euler in I16F16 at
+//! [`Config::braking_model_hz`] (1 kHz). The observer and the plausibility checks run every
+//! tick in every scene: they are the measurement, paced by the sensors.
+//!
 //! # Formats
 //! | quantity | format | range | resolution |
 //! |---|---|---|---|
@@ -66,9 +73,10 @@ mod observer;
 mod scale;
 
 pub use config::{
-    Config, ConfigError, ObserverGains, Thresholds, DEFAULT_OBSERVER_BANDWIDTH_HZ, DEFAULT_TICK_HZ,
+    Config, ConfigError, ObserverGains, Thresholds, DEFAULT_BRAKING_MODEL_HZ,
+    DEFAULT_OBSERVER_BANDWIDTH_HZ, DEFAULT_TICK_HZ,
 };
-pub use io::{BrakeState, Estimate, Flags, Inputs, Scene, ESTIMATE_WORDS};
+pub use io::{BrakeState, Estimate, Flags, Inputs, Scene, SceneModel, ESTIMATE_WORDS};
 pub use scale::{recip_q16, sat_i32, Scale, ScaleError};
 
 use crate::fx::{adc_centered, counter_delta, lowpass, Q16};
@@ -169,6 +177,8 @@ struct BrakingEnvelope {
     expected_counts: i32,
     /// Ticks spent moving after the nominal model stopped.
     overdue_ticks: u32,
+    /// Ticks since the nominal model's last step.
+    model_ticks: u32,
 }
 
 impl BrakingEnvelope {
@@ -271,6 +281,18 @@ impl Monitor {
                 margin_floor: Q16::ZERO,
             },
         })
+    }
+
+    /// The model this monitor runs in `scene` (issue 6: the cheapest per scene,
+    /// docs/results/cheapest-per-scene.md).
+    pub fn scene_model(&self, scene: Scene) -> SceneModel {
+        match scene {
+            Scene::Holding | Scene::Driving => SceneModel::QuasiStatic,
+            Scene::Overrunning => SceneModel::Equilibrium,
+            Scene::FaultBraking => SceneModel::ReducedI16F16Euler {
+                rate_hz: self.p.braking_model_hz,
+            },
+        }
     }
 
     /// The latched flags.
@@ -676,20 +698,29 @@ impl Monitor {
             self.envelope.arm(w);
         } else if scene == Scene::FaultBraking && out_ok {
             let env = &mut self.envelope;
-            let decel = if s == load_sign {
-                engaged_capacity.saturating_sub(load_abs)
-            } else {
-                engaged_capacity.saturating_add(load_abs)
+            // The nominal braking model runs at its own rate (`braking_model_hz`, the
+            // cheapest-per-scene table's choice): one explicit-Euler step over the ticks it
+            // covers, travel with the old speed, then the speed.
+            env.model_ticks = env.model_ticks.saturating_add(n);
+            if env.model_ticks >= p.braking_model_ticks {
+                // ≤ 1000 + 255 ticks (reset at each model step): fits an i32.
+                let k = i32::try_from(env.model_ticks).unwrap_or(i32::MAX);
+                env.model_ticks = 0;
+                let decel = if s == load_sign {
+                    engaged_capacity.saturating_sub(load_abs)
+                } else {
+                    engaged_capacity.saturating_add(load_abs)
+                }
+                .max(Q16::ZERO);
+                env.expected_counts = env.expected_counts.saturating_add(
+                    p.speed_to_counts
+                        .apply(env.expected_speed.to_bits())
+                        .times(k),
+                );
+                let dv = p.obs.v_a.apply(decel.to_bits()).times(k);
+                env.expected_speed =
+                    Q16::from_bits(env.expected_speed.to_bits().saturating_sub(dv).max(0));
             }
-            .max(Q16::ZERO);
-            let dv = p.obs.v_a.apply(decel.to_bits()).times(n_i);
-            env.expected_speed =
-                Q16::from_bits(env.expected_speed.to_bits().saturating_sub(dv).max(0));
-            env.expected_counts = env.expected_counts.saturating_add(
-                p.speed_to_counts
-                    .apply(env.expected_speed.to_bits())
-                    .times(n_i),
-            );
             env.counts = env.counts.saturating_add(d_out.saturating_abs());
             if env.expected_speed == Q16::ZERO {
                 env.overdue_ticks = env.overdue_ticks.saturating_add(n);

@@ -202,7 +202,16 @@ pub struct Config {
     /// Most ticks one late step may cover (1..=32); the observer must be stable when advanced
     /// by any of 1..=this many ticks with one correction.
     pub max_catchup_ticks: u8,
+    /// Rate (Hz) of the fault-braking model (the nominal braking the envelope checks against),
+    /// stepped by explicit Euler in I16F16; `tick_hz` must be a whole multiple of it. Default
+    /// [`DEFAULT_BRAKING_MODEL_HZ`], the cheapest rate meeting the accuracy targets
+    /// (docs/results/cheapest-per-scene.md, `cargo xtask bench`).
+    pub braking_model_hz: f64,
 }
+
+/// Default rate of the fault-braking model (Hz): the cheapest-per-scene table's choice for
+/// both braking scenes (reduced I16F16 explicit Euler at 1 kHz).
+pub const DEFAULT_BRAKING_MODEL_HZ: f64 = 1_000.0;
 
 /// Default observer bandwidth (Hz).
 pub const DEFAULT_OBSERVER_BANDWIDTH_HZ: f64 = 30.0;
@@ -222,6 +231,7 @@ impl Config {
             sliding_mu: mechanism.mu_dynamic,
             backdrive_efficiency: 1.0 / sensors.reducer_efficiency,
             max_catchup_ticks: 8,
+            braking_model_hz: DEFAULT_BRAKING_MODEL_HZ,
         }
     }
 }
@@ -325,6 +335,10 @@ pub(crate) struct Params {
     pub stick_speed: Q16,
     pub min_margin: Scale<26>,
     pub lock_dwell_ticks: u32,
+    /// Ticks per step of the fault-braking model (`tick_hz / braking_model_hz`, ≥ 1).
+    pub braking_model_ticks: u32,
+    /// The fault-braking model's rate (Hz, rounded), for [`super::Monitor::scene_model`].
+    pub braking_model_hz: u32,
     pub persistence_ticks: u32,
     pub settle_ticks: u32,
     pub engage_settle_ticks: u32,
@@ -409,6 +423,21 @@ fn counts(x: f64, parameter: &'static str) -> Result<i32, ConfigError> {
         return Err(ConfigError::Overflow { parameter });
     }
     Ok(((x + 0.5) as i32).max(1))
+}
+
+/// Ticks per step of the fault-braking model: `tick_hz / braking_model_hz`, a whole number from
+/// 1 to 1000 (the model may not run faster than the ticks, and at 1/1000 of them it would not see
+/// a braking event of tens of milliseconds at all).
+fn model_ticks(model_hz: f64, tick_hz: f64) -> Result<u32, ConfigError> {
+    const PARAMETER: &str = "braking_model_hz";
+    let ratio = tick_hz / positive(model_hz, PARAMETER)?;
+    let whole = (ratio + 0.5) as u32; // 0 < ratio ≤ 1e10: `as` saturates, never wraps
+    if !(1..=1000).contains(&whole) || (ratio - f64::from(whole)).abs() > 1e-9 * ratio {
+        return Err(ConfigError::OutOfRange {
+            parameter: PARAMETER,
+        });
+    }
+    Ok(whole)
 }
 
 impl Params {
@@ -672,6 +701,10 @@ impl Params {
             stick_speed: q16(stick, "thresholds.stick_speed_rad_s")?,
             min_margin: scale(min_margin, "thresholds.min_capacity_margin")?,
             lock_dwell_ticks: ticks(t.lock_dwell_s, tick_hz, "thresholds.lock_dwell_s")?,
+            braking_model_ticks: model_ticks(c.braking_model_hz, tick_hz)?,
+            // 100 Hz ≤ tick_hz ≤ 1 MHz and ticks ≥ 1: the rate fits a u32 (`as` is exact).
+            braking_model_hz: (tick_hz / f64::from(model_ticks(c.braking_model_hz, tick_hz)?) + 0.5)
+                as u32,
             persistence_ticks: ticks(
                 t.flag_persistence_s,
                 tick_hz,

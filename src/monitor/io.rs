@@ -58,6 +58,47 @@ pub enum Scene {
     Overrunning = 3,
 }
 
+/// The model the monitor runs in a scene: per scene, the cheapest candidate that meets the
+/// accuracy targets in `docs/results/cheapest-per-scene.md` (written by `cargo xtask bench`;
+/// a host test fails when the two differ). Its [`Display`](core::fmt::Display) is the table's
+/// label.
+///
+/// ```
+/// use noback::monitor::{Config, Monitor, Scene, SceneModel};
+/// let monitor = Monitor::new(Config::default()).unwrap();
+/// assert_eq!(monitor.scene_model(Scene::Holding), SceneModel::QuasiStatic);
+/// assert_eq!(
+///     monitor.scene_model(Scene::FaultBraking),
+///     SceneModel::ReducedI16F16Euler { rate_hz: 1000 }
+/// );
+/// ```
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum SceneModel {
+    /// No state to advance: the output at rest under the pack (holding) or at the drive's
+    /// speed (driving); pack torque and force are quasi-static.
+    QuasiStatic,
+    /// The overrunning equilibrium `T = g₁·v − g₀` from the drive torque; no state.
+    Equilibrium,
+    /// The reduced braking model (speed decreasing at `(T_all ∓ |M̂|)/J_s`, travel) stepped by
+    /// explicit Euler in I16F16 every `tick_hz / rate_hz` ticks: the braking envelope.
+    ReducedI16F16Euler {
+        /// Model steps per second.
+        rate_hz: u32,
+    },
+}
+
+impl core::fmt::Display for SceneModel {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        match *self {
+            SceneModel::QuasiStatic => f.write_str("quasi-static (no state)"),
+            SceneModel::Equilibrium => f.write_str("quasi-static equilibrium"),
+            SceneModel::ReducedI16F16Euler { rate_hz } => {
+                write!(f, "reduced I16F16 euler {} kHz", f64::from(rate_hz) / 1e3)
+            }
+        }
+    }
+}
+
 /// State of the friction pack.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 #[repr(u8)]
