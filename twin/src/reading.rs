@@ -56,6 +56,12 @@ pub struct OpenItems {
     /// Paper reading: after the drive is cut, the output ramp's far face is a stop that pushes
     /// the drag-held connecting shaft (true), or the input side stays where it stopped (false).
     pub paper_far_face_stop: bool,
+    /// Paper reading: angular backlash of the output ramp between its two faces (rad); 0 (the
+    /// default) derives it from Table 2 as `2·g_p1/(r·cosθ)` = 0.028 rad.
+    pub paper_backlash_rad: f64,
+    /// Paper reading: the pack uses μ_s while slipping as well as stuck (true, the paper's
+    /// 60 / 8.2 N·m levels), or μ_d while slipping (false).
+    pub paper_sliding_mu_static: bool,
 }
 
 /// Defaults of the open items (docs/model.md gives the reasons).
@@ -68,6 +74,8 @@ pub const DEFAULT_OPEN: OpenItems = OpenItems {
     shaft_gap_m: 0.0,
     stop_threshold_rad_s: 0.05,
     paper_far_face_stop: true,
+    paper_backlash_rad: 0.0,
+    paper_sliding_mu_static: true,
 };
 
 impl Default for OpenItems {

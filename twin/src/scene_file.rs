@@ -98,6 +98,8 @@ struct RawOpen {
     shaft_gap_m: Option<f64>,
     stop_threshold_rad_s: Option<f64>,
     paper_far_face_stop: Option<bool>,
+    paper_backlash_rad: Option<f64>,
+    paper_sliding_mu_static: Option<bool>,
 }
 
 #[derive(Deserialize)]
@@ -374,6 +376,16 @@ impl RawFile {
         )?;
         if let Some(b) = ro.paper_far_face_stop {
             o.paper_far_face_stop = b;
+        }
+        ranged(
+            &mut o.paper_backlash_rad,
+            ro.paper_backlash_rad,
+            "open.paper_backlash_rad",
+            0.0,
+            1.0,
+        )?;
+        if let Some(b) = ro.paper_sliding_mu_static {
+            o.paper_sliding_mu_static = b;
         }
         for (i, f) in self.fault.iter().enumerate() {
             let kind = FaultKind::parse(&f.kind).ok_or_else(|| {

@@ -19,7 +19,15 @@
 //! - After the drive is cut, the connecting shaft (the input side) is held by the spring-applied
 //!   drag, and the output ramp's far face is a plain stop: an output running against the load
 //!   by more than the ramp backlash `2·g_p1/(r cosθ)` pushes it along (MODEL.md, "Braking
-//!   cases": this is what produces the reverse-load lag).
+//!   cases": this is what produces the reverse-load lag). `open.paper_backlash_rad` overrides
+//!   the derived backlash, `open.paper_far_face_stop` removes the stop and
+//!   `open.paper_sliding_mu_static = false` uses μ_d while slipping (sensitivity only).
+//! - The reading is rigid and has no axial state. Its samples report the pressing force the
+//!   pack torque corresponds to (while tracking, the Filippov mean that holds exactly the load)
+//!   and the quasi-static axial positions it implies through the pack and ball contacts
+//!   (Herbert–McWhannell, Table 2 k), so the continuous-closing axial travel is the pack's
+//!   deflection range. Why several of the paper's figures are out of reach of any rigid
+//!   choice: docs/model.md, "Against the paper".
 
 use super::{at, put, smooth_sign, Drive, ModelConfig, Sample, TwinModel};
 use crate::fault::PhysicsFaults;
@@ -50,8 +58,16 @@ pub struct Paper {
 
 struct Eval {
     dy: [f64; N],
+    /// Pressing force the pack torque corresponds to (N): the full quasi-static force while
+    /// engaged, the spring alone while not, and while tracking the Filippov mean that makes the
+    /// pack torque equal to the load.
     pressing_n: f64,
-    engaged: bool,
+    /// Fraction of the load's ramp force the load face carries (1 engaged, 0 not, between
+    /// while tracking).
+    engaged: f64,
+    /// Pressing force the capacities are computed from (N): spring, drag and, while engaged or
+    /// tracking, the whole ramp force.
+    capacity_pressing_n: f64,
     pack_torque_nm: f64,
     required_nm: f64,
     cap: PackCapacity,
@@ -87,8 +103,12 @@ impl Paper {
         self.drive.on && self.drive.speed_ref_rad_s * self.load_sign() < 0.0
     }
 
-    /// Angular backlash of the output ramp, `2·g_p1/(r·cosθ)` (rad).
+    /// Angular backlash of the output ramp (rad): `open.paper_backlash_rad` if set, otherwise
+    /// derived from Table 2 as `2·g_p1/(r·cosθ)` (0.028 rad: the clearance g_p1 on each face).
     pub fn backlash_rad(&self) -> f64 {
+        if self.cfg.open.paper_backlash_rad > 0.0 {
+            return self.cfg.open.paper_backlash_rad;
+        }
         let m = &self.cfg.mechanism;
         2.0 * m.socket_clearance_m / (m.socket_radius_m * m.socket_chamfer_rad.cos())
     }
@@ -115,7 +135,12 @@ impl Paper {
             0.0
         };
         let pressing_n = spring + self.faults.drag_force_n + ramp;
-        let cap = pack::capacity(m, pressing_n, self.faults.mu_scale, true);
+        let cap = pack::capacity(
+            m,
+            pressing_n,
+            self.faults.mu_scale,
+            self.cfg.open.paper_sliding_mu_static,
+        );
         let bearing = m.mu_dynamic
             * m.output_shaft_mass_kg
             * GRAVITY_M_S2
@@ -124,6 +149,7 @@ impl Paper {
         let stuck = self.mode == FrictionMode::Stuck && !self.driven;
         let required_nm = load - if stuck { 0.0 } else { bearing };
         let mut dy = [0.0; N];
+        let base_n = spring + self.faults.drag_force_n;
         let (pack_torque_nm, drive_nm) = if self.tracking {
             ((-required_nm).clamp(-cap.static_nm, cap.static_nm), 0.0)
         } else if self.driven {
@@ -139,6 +165,22 @@ impl Paper {
         } else {
             (friction::torque_nm(self.mode, required_nm, cap), 0.0)
         };
+        // While tracking the switch is visited in a Filippov mean: report the pressing force
+        // (and the load-face share) that gives exactly the pack torque being applied.
+        let engaged_share = if self.tracking && ramp > 0.0 && pressing_n > 0.0 {
+            let per_n = cap.sliding_nm / pressing_n;
+            if per_n > 0.0 {
+                ((pack_torque_nm.abs() / per_n - base_n) / ramp).clamp(0.0, 1.0)
+            } else {
+                1.0
+            }
+        } else if engaged {
+            1.0
+        } else {
+            0.0
+        };
+        let capacity_pressing_n = pressing_n;
+        let pressing_n = base_n + engaged_share * ramp;
         dy[THETA_S] = w;
         dy[THETA_S + 1] = if self.driven
             || (self.tracking && required_nm.abs() <= cap.static_nm)
@@ -158,7 +200,8 @@ impl Paper {
         Eval {
             dy,
             pressing_n,
-            engaged,
+            engaged: engaged_share,
+            capacity_pressing_n,
             pack_torque_nm,
             required_nm,
             cap,
@@ -200,9 +243,10 @@ impl Paper {
         let e = self.eval(y);
         let spring_only = pack::capacity(
             &self.cfg.mechanism,
-            e.pressing_n - self.cfg.load_torque_nm.abs() * self.cfg.mechanism.ramp_factor_per_m(),
+            e.capacity_pressing_n
+                - self.cfg.load_torque_nm.abs() * self.cfg.mechanism.ramp_factor_per_m(),
             self.faults.mu_scale,
-            true,
+            self.cfg.open.paper_sliding_mu_static,
         );
         // Both sides of the switch push towards it: disengaged the output would gain on the
         // input, engaged it would fall back.
@@ -314,11 +358,16 @@ impl TwinModel for Paper {
     fn sample(&self, t: f64, y: &[f64]) -> Sample {
         let e = self.eval(y);
         let m = &self.cfg.mechanism;
-        let per_ball = if e.engaged {
-            self.cfg.load_torque_nm.abs() / (3.0 * m.socket_radius_m * m.socket_chamfer_rad.cos())
-        } else {
-            0.0
-        };
+        let per_ball = e.engaged * self.cfg.load_torque_nm.abs()
+            / (3.0 * m.socket_radius_m * m.socket_chamfer_rad.cos());
+        // Quasi-static axial positions (docs/model.md, "The `paper` reading"): the big shaft
+        // sits on the pack, deflected by the pressing force through the pack's Herbert–McWhannell
+        // contact (`x = g_p2 + (F_p/k)^(2/3)`); the output balls sit on the output shaft's face,
+        // pressed into it by the axial component of their ramp force.
+        let deflection = |f: f64| (f.max(0.0) / m.contact_stiffness).powf(2.0 / 3.0);
+        let shaft_axial_m =
+            m.pack_clearance_m + self.faults.extra_pack_clearance_m + deflection(e.pressing_n);
+        let ball_axial_m = -deflection(per_ball * m.socket_chamfer_rad.sin());
         Sample {
             t_s: t,
             output_angle_rad: at(y, THETA_S),
@@ -336,8 +385,8 @@ impl TwinModel for Paper {
             },
             contact_force_n: per_ball,
             input_contact_force_n: 0.0,
-            ball_axial_m: 0.0,
-            shaft_axial_m: 0.0,
+            ball_axial_m,
+            shaft_axial_m,
         }
     }
 
