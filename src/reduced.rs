@@ -15,8 +15,9 @@
 //! step's largest speed change, so a zero crossing always lands in it.
 //!
 //! With the drive on, the output is carried at the speed reference and `δ = 0` (along the load
-//! it leans on the load face: the pack is engaged and holds back exactly the load, the twin's
-//! tracking mode; against it the pack is at spring drag); with the drive
+//! it rides the load face's switch, the twin's tracking mode: the pack slips holding back exactly
+//! the load, at the mean pressing force that gives that torque; against it the pack is at spring
+//! drag); with the drive
 //! off the input side stays where it stopped, except that the output ramp's far face is a stop:
 //! `δ ≥ −b` with the ramp backlash `b = 2·g_p1/(r·cosθ)` (it pushes the drag-held input side).
 //!
@@ -182,6 +183,9 @@ struct Consts<N: Real, A: Real> {
     load: N,
     spring: N,
     ramp_force: N,
+    /// Pressing force while tracking (driven along the load): the pack slips at the load minus
+    /// the bearing torque, `(M − M_sf)/cap_sliding`.
+    tracking_force: N,
     cap_static: N::K,
     cap_sliding: N::K,
     bearing: N,
@@ -203,6 +207,11 @@ impl<N: Real, A: Real> Consts<N, A> {
             load: N::from_f64(p.load_nm),
             spring: N::from_f64(p.spring_n),
             ramp_force: N::from_f64(p.load_nm * p.ramp_per_m),
+            tracking_force: N::from_f64(if p.cap_sliding_per_n_m > 0.0 {
+                (p.load_nm - p.bearing_nm) / p.cap_sliding_per_n_m
+            } else {
+                p.spring_n + p.load_nm * p.ramp_per_m
+            }),
             cap_static: N::konst(p.cap_static_per_n_m),
             cap_sliding: N::konst(p.cap_sliding_per_n_m),
             bearing: N::from_f64(p.bearing_nm),
@@ -303,10 +312,11 @@ impl<N: Real + Widen<A>, A: Real> Reduced<N, A> {
     #[inline(always)]
     fn pressing(&self, s: &State<N, A>) -> N {
         if self.drive_on {
-            // Driven along the load the output leans on the load face (engaged); against it,
-            // the input ramp keeps the pack at spring drag.
+            // Driven along the load the output rides the load face's switch (the twin's tracking
+            // mode): the pack slips holding back exactly the load, at the mean force that gives
+            // that torque; against it, the input ramp keeps the pack at spring drag.
             if self.speed_ref > N::ZERO {
-                self.c.spring.add(self.c.ramp_force)
+                self.c.tracking_force
             } else {
                 self.c.spring
             }

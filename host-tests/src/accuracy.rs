@@ -1,10 +1,10 @@
 //! The monitor against the twin: run the shipped monitor over a twin trace and measure how far
 //! its estimates are from the twin's truth, and when its flags come.
 //!
-//! The monitor does not model the ball–socket contact impacts on purpose (they ring at hundreds
-//! of hertz and carry no braking information), so the twin's pressing force and braking torque
-//! are compared after a centred moving average over [`COMPARE_WINDOW_S`] — the "compared"
-//! signal. Both the raw and the compared truth are kept, and the plot shows both.
+//! The twin's ball–socket contact impacts ring at hundreds of hertz; the monitor sees them only
+//! through the output encoder (the inertia torque `J_s·α` of its second difference over 2 × 1.6
+//! ms while the brake holds), so the twin's pressing force and braking torque are compared after
+//! a centred moving average over [`COMPARE_WINDOW_S`] — the "compared" signal. Both the raw and the compared truth are kept, and the plot shows both.
 //! Definitions (also in docs/monitor.md):
 //! - pressing-force RMS error: over every sample, monitor − compared twin; in % of the compared
 //!   twin's peak.

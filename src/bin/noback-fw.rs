@@ -130,6 +130,9 @@ mod target {
         let (a, b) = (meter.now(), meter.now());
         let overhead = Meter::ticks(a, b);
         let (mut sum, mut max, mut steps) = (0_u64, 0_u32, 0_u32);
+        // Worst step per recognised scene (Scene as u8: Driving, Holding, FaultBraking,
+        // Overrunning): what each scene's model costs.
+        let mut scene_max = [0_u32; 4];
         let mut digest = Fnv1a::new();
         while let Some(inputs) = replay.sample() {
             let start = meter.now();
@@ -137,6 +140,9 @@ mod target {
             let ticks = Meter::ticks(start, meter.now()).saturating_sub(overhead);
             sum += u64::from(ticks);
             max = max.max(ticks);
+            if let Some(m) = scene_max.get_mut(usize::from(estimate.scene as u8)) {
+                *m = (*m).max(ticks);
+            }
             steps += 1;
             digest.push(noback::app::estimate_checksum(&estimate));
         }
@@ -148,6 +154,13 @@ mod target {
             overhead,
             stack::high_water_bytes(),
             digest.value()
+        );
+        defmt::info!(
+            "bench-scenes driving={=u32} holding={=u32} fault_braking={=u32} overrunning={=u32}",
+            scene_max[0],
+            scene_max[1],
+            scene_max[2],
+            scene_max[3]
         );
         platform::exit(noback::exit_code::SUCCESS)
     }

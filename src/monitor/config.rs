@@ -140,6 +140,10 @@ pub struct Thresholds {
     /// Time over which an impact in the lost motion may reverse the output speed before the
     /// observer follows (s): widens the innovation limit by `2·|ω̂|·this`.
     pub impact_time_s: f64,
+    /// Half-width of the encoder's second difference that measures an impact while holding
+    /// (s; 1 to 31 ticks): the braking torque reported while the brake holds is
+    /// `M̂ − J_s·α` with `α` the output's acceleration over the last two such windows.
+    pub impact_window_s: f64,
 }
 
 impl Thresholds {
@@ -167,6 +171,7 @@ impl Thresholds {
         adc_rail_time_s: 0.002,
         health_rate_per_s: 25.0,
         impact_time_s: 0.01,
+        impact_window_s: 0.0016,
     };
 }
 
@@ -352,6 +357,10 @@ pub(crate) struct Params {
     pub impact_words: Scale<16>,
     /// Decay of the recent peak speed per tick (Q16 rad/s bits): [`IMPACT_DECAY_RAD_S2`]·h.
     pub impact_decay: i32,
+    /// Ticks `m` of the impact's second difference (1..=31).
+    pub impact_window: u8,
+    /// Second difference of the output position (counts) → Q16 N·m: `J_s·Δθ/(m·h)²`.
+    pub impact_torque: Scale<8>,
     /// Gain of the load filter, run on every other tick.
     pub load_alpha: Gain,
     /// `T_drive + drag_allowance`: the pack torque above which a driving pack drags.
@@ -660,6 +669,15 @@ impl Params {
                 parameter: "thresholds.health_rate_per_s",
             });
         }
+        let impact_m = {
+            let m = positive(t.impact_window_s, "thresholds.impact_window_s")? * tick_hz + 0.5;
+            if !(1.0..32.0).contains(&m) {
+                return Err(ConfigError::OutOfRange {
+                    parameter: "thresholds.impact_window_s",
+                });
+            }
+            m as u8 // 1 ≤ m < 32 (checked above)
+        };
         Ok(Params {
             adc_bits: s.current_adc_bits,
             adc_max_code: ((1_u32 << s.current_adc_bits) - 1) as u16,
@@ -738,6 +756,11 @@ impl Params {
                 2.0 * positive(t.impact_time_s, "thresholds.impact_time_s")? * words_per_rad
                     / Q16_ONE,
                 "thresholds.impact_time_s",
+            )?,
+            impact_window: impact_m,
+            impact_torque: scale(
+                j * out_rad / ((f64::from(impact_m) * h) * (f64::from(impact_m) * h)) * Q16_ONE,
+                "thresholds.impact_window_s",
             )?,
             // 1e-3 rad/s per tick at 10 kHz, ≥ 1 LSB at any tick rate; `as` is exact here
             // (0 < value < 2^31 for any accepted tick rate).

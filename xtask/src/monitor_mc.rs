@@ -251,7 +251,7 @@ fn doc(a: &Args, r: &serde_json::Value) -> String {
          brake_drag; sensor faults: sensor_fault). Target: ≥ {:.0} % of manifested runs per \
          kind, and no false alarm in the nominal runs.\n\
          - Accuracy: the twin's pressing force and braking torque are compared after a centred \
-         {:.0} ms moving average (the monitor does not model ball–socket impacts on purpose); \
+         {:.0} ms moving average (the monitor sees ball–socket impacts only as the output's inertia torque over 3.2 ms); \
          `cargo xtask monitor SCENE` plots raw and compared signals.\n\n\
          ## Results\n\n{}\n\
          Targets met: **{}**.\n",

@@ -196,6 +196,14 @@ pub fn replay_report(
 
     let ticks: u32 = field(&summary, "ticks")?;
     let (insns_mean, insns_max) = step_insns(&bench_line, core)?;
+    // Worst step per recognised scene (0 where the scene never occurs in this trace).
+    let scene_line = line_with(&bench.lines, "bench-scenes")?;
+    let per_insn = core.ticks_per_insn(BENCH_SHIFT);
+    let mut max_by_scene = serde_json::Map::new();
+    for name in ["driving", "holding", "fault_braking", "overrunning"] {
+        let ticks: f64 = field::<u32>(&scene_line, name)?.into();
+        max_by_scene.insert(name.into(), json!((ticks / per_insn).round()));
+    }
     let size = elf_size::of_file(&elf)?;
     let flash_bytes = size.flash_bytes.saturating_sub(bytes.len() as u64);
     let stack_bytes: u32 = field(&summary, "stack_bytes")?;
@@ -250,6 +258,7 @@ pub fn replay_report(
         "flags": flags,
         "insns_per_step_mean": (insns_mean * 10.0).round() / 10.0,
         "insns_per_step_max": insns_max.round(),
+        "insns_per_step_max_by_scene": max_by_scene,
         "isr_insns_max": (isr_ticks_max / core.ticks_per_insn(REALTIME_SHIFT)).round(),
         "deadline_used_pct": (1000.0 * isr_ticks_max / period_ticks).round() / 10.0,
         "flash_bytes": flash_bytes,
