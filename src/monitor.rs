@@ -59,9 +59,10 @@
 //!
 //! # Cost
 //! `cargo xtask run --json` (Cortex-M3 under QEMU, the twin's reverse_load trace, release, LTO):
-//! mean 857.6, max 993 instructions per step (budget 1000; the worst step per scene is in the
-//! command's `insns_per_step_max_by_scene`). The load filter runs on even ticks
-//! and the drag check on odd ticks so that no step carries both.
+//! mean 854.6, max 966 instructions per step (budget 1000; the worst step per scene is in the
+//! command's `insns_per_step_max_by_scene`). The periodic parts (load filter or pack health,
+//! drive checks, friction energy, load-cache refresh) each have their own tick modulo 4, so
+//! that no step carries two of them (`step`, "Cost"; docs/monitor-design.md, "Cost").
 //!
 //! # Missed ticks
 //! The caller sets [`Inputs::ticks_elapsed`] to the number of ticks since the previous call
@@ -70,6 +71,7 @@
 //! measurement and the estimate is untrusted until it settles again.
 
 mod config;
+mod drive_checks;
 mod io;
 mod observer;
 mod scale;
@@ -83,6 +85,7 @@ pub use scale::{recip_q16, sat_i32, Scale, ScaleError};
 
 use crate::fx::{adc_centered, counter_delta, lowpass, Q16};
 use config::Params;
+use drive_checks::{DriveChecks, DriveTick};
 use fixed::types::U40F24;
 use observer::Observer;
 
@@ -103,6 +106,9 @@ fn mul_q16(a: Q16, b: Q16) -> Q16 {
 /// Length of the output-position history (ticks): more than twice the longest impact window
 /// (31 ticks), a power of two so that the ring index is a mask.
 const POSITION_HISTORY: usize = 64;
+
+/// The tick (modulo 16) on which a changed load refreshes the load cache.
+const REFRESH_PHASE: u32 = 3;
 
 /// Pack health is kept within [0, 2].
 const HEALTH_MAX: i32 = 2 << 16;
@@ -158,9 +164,12 @@ pub struct Monitor {
     still_out: u32,
     still_motor: u32,
     weak_ticks: u32,
-    drag_ticks: u32,
+    /// The drag and step checks of a running drive.
+    drive_checks: DriveChecks,
     health: Q16,
     energy: U40F24,
+    /// Ticks since the friction energy was last sampled.
+    energy_ticks: u32,
     flags: Flags,
     /// Quantities that depend only on the load estimate, recomputed when it changes.
     load_cache: LoadCache,
@@ -176,6 +185,23 @@ struct LoadCache {
     recip: Q16,
     /// `min_capacity_margin · |M̂|` (N·m).
     margin_floor: Q16,
+    /// The pack health the two below were formed with.
+    health: Q16,
+    /// Capacity scaled by the health, `health · capacity` (N·m).
+    available: Q16,
+    /// `available / |M̂|`, at most [`MARGIN_MAX`].
+    margin: Q16,
+}
+
+impl LoadCache {
+    /// Forms `available` and `margin` for `health` (two products, only when the health or
+    /// the load changed: most ticks reuse them).
+    #[inline]
+    fn with_health(&mut self, health: Q16) {
+        self.health = health;
+        self.available = mul_q16(health, self.capacity);
+        self.margin = mul_q16(self.available, self.recip).min(MARGIN_MAX);
+    }
 }
 
 /// The braking envelope of one braking event (drive cut to lock).
@@ -284,9 +310,10 @@ impl Monitor {
             still_out: 0,
             still_motor: 0,
             weak_ticks: 0,
-            drag_ticks: 0,
+            drive_checks: DriveChecks::default(),
             health: Q16::ONE,
             energy: U40F24::ZERO,
+            energy_ticks: 0,
             flags: Flags::default(),
             load_cache: LoadCache {
                 load: Q16::ZERO,
@@ -294,6 +321,9 @@ impl Monitor {
                 capacity: Q16::ZERO,
                 recip: Q16::ZERO,
                 margin_floor: Q16::ZERO,
+                health: Q16::ONE,
+                available: Q16::ZERO,
+                margin: Q16::ZERO,
             },
         })
     }
@@ -341,7 +371,7 @@ impl Monitor {
     pub fn reset_flags(&mut self) {
         self.flags = Flags::default();
         self.weak_ticks = 0;
-        self.drag_ticks = 0;
+        self.drive_checks.disarm();
         self.envelope = BrakingEnvelope::default();
         // Creep is measured afresh from here (the span, not its validity: a reset while
         // holding keeps the slip check armed).
@@ -554,7 +584,8 @@ impl Monitor {
         };
 
         // ---- Drive edges.
-        if drive != self.prev_drive {
+        let drive_edge = drive != self.prev_drive;
+        if drive_edge {
             if drive {
                 self.load_ref = self.load;
                 self.load_ref_known = self.load_known;
@@ -675,11 +706,15 @@ impl Monitor {
             && !self.locked
             && phase_settled
             && self.reading_ticks == 0;
-        // Cost: the load filter (with the load cache it invalidates) runs on even ticks and
-        // the drag check on odd ticks, so no step carries both (each at 5 kHz, counting two
-        // ticks per run; the flags' persistence and the filter's 10 Hz are unchanged).
+        // Cost: the periodic work is spread over the ticks so that no step carries two of the
+        // expensive parts. Tick modulo 4 — 0: the load filter (drive on) or the pack-health
+        // update (drive off); 1: the drive checks (drive on); 2: the friction energy; 3: the
+        // load cache's refresh (one in four, `REFRESH_PHASE` mod 16, drive on). The braking
+        // model's step (drive off, every `braking_model_ticks`) waits for an odd tick. Each
+        // periodic part counts the ticks it covers; time constants and persistence are those
+        // of the tick rate.
         let even_tick = self.tick & 1 == 0;
-        if moving_ok && drive && even_tick {
+        if moving_ok && drive && self.tick & 3 == 0 {
             // The pack torque is known while the drive runs: the drive drag when the drive
             // carries the load, the overrunning equilibrium when the load runs along:
             // M = N + s·T_pack.
@@ -690,7 +725,7 @@ impl Monitor {
             };
             let inst = net.saturating_add(signed(s, pack));
             self.load = lowpass(self.load, inst, p.load_alpha);
-            self.load_learn_ticks = self.load_learn_ticks.saturating_add(n.saturating_mul(2));
+            self.load_learn_ticks = self.load_learn_ticks.saturating_add(n.saturating_mul(4));
             if self.load_learn_ticks >= p.load_known_ticks {
                 if !self.load_known && !self.load_ref_known {
                     // First known load of a drive that started without one (power-on while
@@ -702,7 +737,18 @@ impl Monitor {
             }
         }
         let load_abs = self.load.saturating_abs();
-        if !self.load_cache.valid || self.load_cache.load != self.load {
+        // The cache follows a changing load (learned only while driving) once in 16 ticks (1.6 ms
+        // at 10 kHz; the flags that use it persist 10 ms), never on the tick of a drive edge
+        // (which has its own bookkeeping): its reciprocal and products are the most expensive
+        // lines of a step. With the drive off the load is held, and so is the cache: it keeps
+        // the load of at most 16 ticks before the cut (the held load differs from it by at
+        // most the filter's movement over 1.6 ms, 9.5 % of its last step).
+        if !self.load_cache.valid
+            || (self.load_cache.load != self.load
+                && drive
+                && self.tick & 15 == REFRESH_PHASE
+                && !drive_edge)
+        {
             let force = p
                 .spring_force
                 .saturating_add(Q16::from_bits(p.ramp_factor.apply(load_abs.to_bits())));
@@ -712,13 +758,18 @@ impl Monitor {
                 capacity: Q16::from_bits(p.capacity_per_n.apply(force.to_bits())),
                 recip: Q16::from_bits(recip_q16(load_abs.to_bits())),
                 margin_floor: Q16::from_bits(p.min_margin.apply(load_abs.to_bits())),
+                health: self.health,
+                available: Q16::ZERO,
+                margin: Q16::ZERO,
             };
+            self.load_cache.with_health(self.health);
         }
         let engaged_capacity = self.load_cache.capacity;
         let measured_brake = self.load.saturating_sub(net);
 
         // ---- Pack health (sign-LMS, no division): measured over model torque while slipping.
-        if moving_ok && !drive && self.load_known {
+        // On ticks ≡ 0 mod 4 (the step covers four; see "Cost" above).
+        if moving_ok && !drive && self.load_known && self.tick & 3 == 0 {
             let predicted = mul_q16(self.health, engaged_capacity);
             let step = if signed(s, measured_brake) > predicted {
                 p.health_step
@@ -734,7 +785,10 @@ impl Monitor {
         }
 
         // ---- Flags.
-        let available = mul_q16(self.health, engaged_capacity);
+        if self.load_cache.health != self.health {
+            self.load_cache.with_health(self.health);
+        }
+        let available = self.load_cache.available;
         let margin_low =
             self.load_known && load_abs >= min_load && available < self.load_cache.margin_floor;
         self.weak_ticks = if margin_low {
@@ -757,22 +811,34 @@ impl Monitor {
             // cheapest-per-scene table's choice): one explicit-Euler step over the ticks it
             // covers, travel with the old speed, then the speed.
             env.model_ticks = env.model_ticks.saturating_add(n);
-            if env.model_ticks >= p.braking_model_ticks {
-                // ≤ 1000 + 255 ticks (reset at each model step): fits an i32.
-                let k = i32::try_from(env.model_ticks).unwrap_or(i32::MAX);
-                env.model_ticks = 0;
+            // On odd ticks only (the pack-health update takes the even ones).
+            if env.model_ticks >= p.braking_model_ticks && !even_tick {
                 let decel = if s == load_sign {
                     engaged_capacity.saturating_sub(load_abs)
                 } else {
                     engaged_capacity.saturating_add(load_abs)
                 }
                 .max(Q16::ZERO);
-                env.expected_counts = env.expected_counts.saturating_add(
-                    p.speed_to_counts
-                        .apply(env.expected_speed.to_bits())
-                        .times(k),
-                );
-                let dv = p.obs.v_a.apply(decel.to_bits()).times(k);
+                // The usual step covers exactly `braking_model_ticks` ticks: its constants are
+                // precomputed; a longer one (a late tick, or the first step after an arm on an
+                // even tick) multiplies the per-tick ones.
+                let (travel, dv) = if env.model_ticks == p.braking_model_ticks {
+                    (
+                        p.braking_travel.apply(env.expected_speed.to_bits()),
+                        p.braking_speed.apply(decel.to_bits()),
+                    )
+                } else {
+                    // ≤ 1000 + 256 ticks (reset at each model step): fits an i32.
+                    let k = i32::try_from(env.model_ticks).unwrap_or(i32::MAX);
+                    (
+                        p.speed_to_counts
+                            .apply(env.expected_speed.to_bits())
+                            .times(k),
+                        p.obs.v_a.apply(decel.to_bits()).times(k),
+                    )
+                };
+                env.model_ticks = 0;
+                env.expected_counts = env.expected_counts.saturating_add(travel);
                 env.expected_speed =
                     Q16::from_bits(env.expected_speed.to_bits().saturating_sub(dv).max(0));
             }
@@ -801,23 +867,30 @@ impl Monitor {
                 self.creep_valid = false;
             }
         }
-        if !even_tick {
-            if scene == Scene::Driving && moving_ok {
-                // s = ±1 here (moving).
-                let implied = net.saturating_add(signed(s, p.drive_drag)); // load if drag nominal
-                let over_model = implied.saturating_abs() > p.max_load;
-                let excess = self.load_ref_known
-                    && signed(s, self.load_ref.saturating_sub(net)) > p.drag_limit;
-                self.drag_ticks = if over_model || excess {
-                    self.drag_ticks.saturating_add(n.saturating_mul(2))
-                } else {
-                    0
-                };
-                if self.drag_ticks >= p.persistence_ticks {
-                    self.flags.brake_drag = true;
-                }
+        if self.tick & 3 == 1 {
+            if drive && moving_ok {
+                // Out of line: the drive-off ticks (braking, holding: the worst case) do not
+                // carry these checks' registers.
+                self.drive_checks.run(
+                    &mut self.flags,
+                    p,
+                    &DriveTick {
+                        s,
+                        net,
+                        pack: if engaged {
+                            overrun_torque
+                        } else {
+                            p.drive_drag
+                        },
+                        engaged,
+                        carrying: scene == Scene::Driving,
+                        history_ok: self.phase_ticks >= p.settle_ticks,
+                        load_ref: self.load_ref_known.then_some(self.load_ref),
+                        ticks: n,
+                    },
+                );
             } else {
-                self.drag_ticks = 0;
+                self.drive_checks.disarm();
             }
         }
 
@@ -905,17 +978,24 @@ impl Monitor {
             model_capacity,
         );
 
-        // ---- Friction energy: slip power |T·ω| integrated (saturating; monotone).
-        if !self.locked {
-            let power = mul_q16(braking_torque, w).saturating_abs();
-            let joules = p.energy_per_tick.apply(power.to_bits()).max(0) as u64 * u64::from(n);
-            self.energy = U40F24::from_bits(self.energy.to_bits().saturating_add(joules));
+        // ---- Friction energy: slip power |T·ω| integrated (saturating; monotone), sampled on
+        // ticks ≡ 2 mod 4 over the ticks since the last sample (2.5 kHz: a heat estimate; the
+        // other ticks carry the other periodic work).
+        self.energy_ticks = self.energy_ticks.saturating_add(n);
+        if self.tick & 3 == 2 {
+            if !self.locked {
+                let power = mul_q16(braking_torque, w).saturating_abs();
+                let joules = p.energy_per_tick.apply(power.to_bits()).max(0) as u64
+                    * u64::from(self.energy_ticks);
+                self.energy = U40F24::from_bits(self.energy.to_bits().saturating_add(joules));
+            }
+            self.energy_ticks = 0;
         }
 
         let capacity_margin = if load_abs < min_load {
             MARGIN_MAX
         } else {
-            mul_q16(available, self.load_cache.recip).min(MARGIN_MAX)
+            self.load_cache.margin
         };
         let brake = if self.locked {
             BrakeState::Locked

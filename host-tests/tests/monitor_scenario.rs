@@ -43,6 +43,8 @@ struct Plant {
     energy: f64,
     /// `energy` after each tick.
     energy_log: Vec<f64>,
+    /// Gain of the current reading (1 = healthy; 0 = open wire).
+    current_gain: f64,
     /// Pressing force while driving (N), the last sub-step of the tick.
     drive_force: f64,
     /// `drive_force` after each tick.
@@ -66,6 +68,7 @@ impl Plant {
             out_offset: 16_300.0,
             energy: 0.0,
             energy_log: Vec::new(),
+            current_gain: 1.0,
             drive_force: 0.0,
             drive_force_log: Vec::new(),
         }
@@ -185,6 +188,7 @@ impl Plant {
             u * s.reducer_efficiency / k
         };
         let noise = self.next_noise();
+        let current = current * self.current_gain;
         let code = (2048.0 + (current / s.amps_per_count()).round()) as i32 + noise;
         let out = (self.theta / s.output_rad_per_count() + self.out_offset).floor() as i64;
         let motor = (self.theta_in / s.input_rad_per_motor_count()).floor() as i64;
@@ -410,6 +414,90 @@ fn dragging_pack_while_driving_raises_brake_drag() {
     );
 }
 
+/// Drives at `speed` under a negative `load` (positive speed: against it, the drive carries the
+/// load; negative: along it, overrunning) for 0.4 s, then changes the plant with `change` and
+/// drives 0.3 s more; returns the trace and the time of the change.
+fn drive_with_a_change(
+    load: f64,
+    speed: f64,
+    change: impl Fn(&mut Plant, f64),
+) -> (Vec<(f64, f64, Estimate)>, f64) {
+    let mut plant = Plant::new(load, speed);
+    let mut monitor = Monitor::new(Config::default()).unwrap();
+    let mut trace = Vec::new();
+    let at = 0.4;
+    for k in 0..7000 {
+        let t = f64::from(k) * H;
+        change(&mut plant, t - at);
+        plant.tick(Some(speed));
+        let e = monitor.step(&plant.inputs(true));
+        trace.push((t + H, plant.omega, e));
+    }
+    (trace, at)
+}
+
+#[test]
+fn current_reading_losing_gain_mid_drive_raises_sensor_fault() {
+    // Half the current lost (severity 0.5, the smallest the Monte Carlo draws) while the drive
+    // carries a 20 N·m load: the drive torque seems to fall by 11 N·m at once. (Overrunning,
+    // the drive torque is 2–4 N·m and half of it is below the step allowance: docs/monitor.md
+    // counts those misses.)
+    let (trace, at) = drive_with_a_change(-20.0, 5.0, |p, since| {
+        p.current_gain = if since >= 0.0 { 0.5 } else { 1.0 };
+    });
+    let before = trace.iter().rfind(|x| x.0 < at).unwrap().2;
+    assert!(!before.flags.any(), "{:?}", before.flags);
+    assert_eq!(before.scene, Scene::Driving);
+    let seen = first_time(&trace, |x| x.2.flags.sensor_fault).expect("sensor_fault");
+    println!("current gain 0.5 at {at} s: sensor_fault at {seen:.4} s");
+    assert!(seen > at && seen - at <= 0.05, "{seen}");
+    assert!(!trace.last().unwrap().2.flags.brake_drag);
+}
+
+#[test]
+fn pack_starting_to_drag_mid_drive_raises_brake_drag() {
+    // 5 N·m more drag, below the 8 N·m allowance against the drive's start: only the step sees it.
+    for (load, speed) in [(-20.0, 5.0), (-10.0, -5.0)] {
+        let (trace, at) = drive_with_a_change(load, speed, |p, since| {
+            p.extra_drag_nm = if since >= 0.0 { 5.0 } else { 0.0 };
+        });
+        let before = trace.iter().rfind(|x| x.0 < at).unwrap().2;
+        assert!(!before.flags.any(), "{:?}", before.flags);
+        let expected_scene = if speed > 0.0 {
+            Scene::Driving
+        } else {
+            Scene::Overrunning
+        };
+        assert_eq!(before.scene, expected_scene);
+        let seen = first_time(&trace, |x| x.2.flags.brake_drag).expect("brake_drag");
+        println!("{expected_scene:?}: drag +5 N·m at {at} s: brake_drag at {seen:.4} s");
+        assert!(seen > at && seen - at <= 0.05, "{seen}");
+        assert!(!trace.last().unwrap().2.flags.sensor_fault);
+    }
+}
+
+#[test]
+fn load_changing_at_a_door_like_rate_mid_drive_raises_nothing() {
+    // The load grows and shrinks by 6 N·m at 20 N·m/s (a door's aerodynamic load over its
+    // stroke changes by tens of N·m per second at most): slower than the step history follows.
+    // (A 10 N·m load against the drive seen first at power-on is read as overrunning — the
+    // ambiguity of docs/monitor-design.md — and a later change of its reading compares loads
+    // learned under two readings: that case raises brake_drag and is left out here.)
+    for (load, speed) in [(-20.0, 5.0), (-10.0, -5.0)] {
+        for sign in [1.0, -1.0] {
+            let (trace, _) = drive_with_a_change(load, speed, |p, since| {
+                p.load_nm = load - sign * (20.0 * since).clamp(0.0, 6.0);
+            });
+            let last = trace.last().unwrap().2;
+            assert!(
+                !last.flags.any(),
+                "speed {speed}, load ramp {sign}: {:?}",
+                last.flags
+            );
+        }
+    }
+}
+
 #[test]
 fn nominal_restart_raises_nothing() {
     let mut plant = Plant::new(-10.0, 5.0);
@@ -440,6 +528,24 @@ mod envelope {
     /// the load: the impact estimate looks back 2 × 16 ticks.
     const QUIET_TICKS: u32 = 33;
 
+    /// For each estimate of a trace, the loads of the last 16 estimates with the drive on (the
+    /// ones the monitor's load cache may hold).
+    fn cache_loads(trace: &[(f64, f64, Estimate)]) -> Vec<Vec<f64>> {
+        let mut window: Vec<f64> = Vec::new();
+        trace
+            .iter()
+            .map(|(_, _, e)| {
+                if matches!(e.scene, Scene::Driving | Scene::Overrunning) {
+                    window.push(e.load_torque_nm.to_num::<f64>());
+                    if window.len() > 16 {
+                        window.remove(0);
+                    }
+                }
+                window.clone()
+            })
+            .collect()
+    }
+
     /// For each estimate of a trace, whether the plant's output has been at rest for
     /// [`QUIET_TICKS`] ticks.
     fn quiet(trace: &[(f64, f64, Estimate)]) -> Vec<bool> {
@@ -457,7 +563,7 @@ mod envelope {
     /// drive torque, braking torque) with the physical reading's laws. `quiet`: the output has
     /// been at rest long enough for the holding torque to be the load alone (otherwise it also
     /// carries the output's inertia torque, checked in the library's unit test).
-    fn check_shadow(e: &Estimate, quiet: bool) -> Result<(), TestCaseError> {
+    fn check_shadow(e: &Estimate, quiet: bool, cache_loads: &[f64]) -> Result<(), TestCaseError> {
         let m = TABLE2;
         let load = e.load_torque_nm.to_num::<f64>();
         let spring = m.spring_preload_n();
@@ -495,14 +601,25 @@ mod envelope {
             );
         }
         if load.abs() >= 1.0 {
-            let cap = m.pack_capacity_nm(m.quasi_static_pressing_force_n(load), m.mu_static);
-            let margin = e.pack_health.to_num::<f64>() * cap / load.abs();
+            // The margin is formed from the load cache, which follows the load once in 16
+            // ticks while driving and holds with the drive off: it matches one of the loads
+            // of the last 16 driving ticks.
             let got = e.capacity_margin.to_num::<f64>();
+            let margin = |l: f64| {
+                let cap = m.pack_capacity_nm(m.quasi_static_pressing_force_n(l), m.mu_static);
+                // A zero load: the reciprocal saturates, and so does the margin.
+                (e.pack_health.to_num::<f64>() * cap / l.abs().max(1e-12)).min(1000.0)
+            };
+            let matched = cache_loads
+                .iter()
+                .chain(std::iter::once(&load))
+                .any(|&l| (got - margin(l)).abs() <= 1e-3 * margin(l) + 1e-4);
             prop_assert!(
-                (got - margin.min(1000.0)).abs() <= 1e-3 * margin + 1e-4,
-                "margin {} vs {}",
+                matched,
+                "margin {} vs {} (loads {:?})",
                 got,
-                margin
+                margin(load),
+                cache_loads
             );
         }
         if e.brake == BrakeState::Locked && quiet {
@@ -551,8 +668,8 @@ mod envelope {
             plant.out_offset = offset;
             let mut monitor = Monitor::new(Config::default()).unwrap();
             let trace = run(&mut plant, &mut monitor, speed, 0.3, 1.0);
-            for ((t, w, e), q) in trace.iter().zip(quiet(&trace)) {
-                check_shadow(e, q)?;
+            for (((t, w, e), q), c) in trace.iter().zip(quiet(&trace)).zip(cache_loads(&trace)) {
+                check_shadow(e, q, &c)?;
                 if *t > 0.15 {
                     let got = e.output_speed_rad_s.to_num::<f64>();
                     prop_assert!((got - w).abs() <= 0.5 + 0.05 * w.abs(), "t {} speed {} vs {}", t, got, w);
@@ -590,8 +707,8 @@ mod envelope {
             plant.out_offset = offset;
             let mut monitor = Monitor::new(Config::default()).unwrap();
             let trace = run(&mut plant, &mut monitor, speed, 0.3, 1.0);
-            for ((_, _, e), q) in trace.iter().zip(quiet(&trace)) {
-                check_shadow(e, q)?;
+            for (((_, _, e), q), c) in trace.iter().zip(quiet(&trace)).zip(cache_loads(&trace)) {
+                check_shadow(e, q, &c)?;
             }
             let last = trace.last().unwrap().2;
             prop_assert_eq!(last.brake, BrakeState::Locked);
@@ -623,8 +740,8 @@ mod envelope {
             // left out of the speed comparison.
             let mut stopped_at = f64::NEG_INFINITY;
             let mut prev_w = speed;
-            for ((t, w, e), q) in trace.iter().zip(quiet(&trace)) {
-                check_shadow(e, q)?;
+            for (((t, w, e), q), c) in trace.iter().zip(quiet(&trace)).zip(cache_loads(&trace)) {
+                check_shadow(e, q, &c)?;
                 if *w == 0.0 && prev_w != 0.0 {
                     stopped_at = *t;
                 }

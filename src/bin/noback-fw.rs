@@ -133,6 +133,7 @@ mod target {
         // Worst step per recognised scene (Scene as u8: Driving, Holding, FaultBraking,
         // Overrunning): what each scene's model costs.
         let mut scene_max = [0_u32; 4];
+        let mut scene_max_at = [0_u32; 4];
         let mut digest = Fnv1a::new();
         while let Some(inputs) = replay.sample() {
             let start = meter.now();
@@ -140,8 +141,12 @@ mod target {
             let ticks = Meter::ticks(start, meter.now()).saturating_sub(overhead);
             sum += u64::from(ticks);
             max = max.max(ticks);
-            if let Some(m) = scene_max.get_mut(usize::from(estimate.scene as u8)) {
-                *m = (*m).max(ticks);
+            let scene = usize::from(estimate.scene as u8);
+            if let (Some(m), Some(at)) = (scene_max.get_mut(scene), scene_max_at.get_mut(scene)) {
+                if ticks > *m {
+                    *m = ticks;
+                    *at = steps;
+                }
             }
             steps += 1;
             digest.push(noback::app::estimate_checksum(&estimate));
@@ -156,11 +161,15 @@ mod target {
             digest.value()
         );
         defmt::info!(
-            "bench-scenes driving={=u32} holding={=u32} fault_braking={=u32} overrunning={=u32}",
+            "bench-scenes driving={=u32} holding={=u32} fault_braking={=u32} overrunning={=u32} driving_at={=u32} holding_at={=u32} fault_braking_at={=u32} overrunning_at={=u32}",
             scene_max[0],
             scene_max[1],
             scene_max[2],
-            scene_max[3]
+            scene_max[3],
+            scene_max_at[0],
+            scene_max_at[1],
+            scene_max_at[2],
+            scene_max_at[3]
         );
         platform::exit(noback::exit_code::SUCCESS)
     }

@@ -114,6 +114,13 @@ pub struct Thresholds {
     pub min_load_nm: f64,
     /// Pack torque above the nominal spring drag allowed while driving (N·m): `brake_drag`.
     pub drag_allowance_nm: f64,
+    /// Step of the current-implied load while driving (N·m), against its recent history (a
+    /// low-pass at `step_reference_hz`): a pack that starts to drag (the drive pushes harder:
+    /// `brake_drag`) or a current reading that loses gain (`sensor_fault`). Genuine load
+    /// changes are slower than the history follows.
+    pub step_allowance_nm: f64,
+    /// Corner frequency of the implied load's recent history (Hz).
+    pub step_reference_hz: f64,
     /// A brake condition must persist this long before its flag latches (s).
     pub flag_persistence_s: f64,
     /// Observer settling time after power-on or re-initialisation (s); untrusted meanwhile.
@@ -159,6 +166,8 @@ impl Thresholds {
         min_capacity_margin: 1.5,
         min_load_nm: 1.0,
         drag_allowance_nm: 8.0,
+        step_allowance_nm: 2.5,
+        step_reference_hz: 5.0,
         flag_persistence_s: 0.01,
         settle_time_s: 0.1,
         engage_settle_s: 0.02,
@@ -344,6 +353,12 @@ pub(crate) struct Params {
     pub braking_model_ticks: u32,
     /// The fault-braking model's rate (Hz, rounded), for [`super::Monitor::scene_model`].
     pub braking_model_hz: u32,
+    /// One braking-model step: Q16 rad/s → Q16 output counts travelled (`speed_to_counts` ×
+    /// `braking_model_ticks`).
+    pub braking_travel: Scale<20>,
+    /// One braking-model step: Q16 N·m → Q16 rad/s of speed change (`h/J` ×
+    /// `braking_model_ticks`).
+    pub braking_speed: Scale<30>,
     pub persistence_ticks: u32,
     pub settle_ticks: u32,
     pub engage_settle_ticks: u32,
@@ -361,11 +376,20 @@ pub(crate) struct Params {
     pub impact_window: u8,
     /// Second difference of the output position (counts) → Q16 N·m: `J_s·Δθ/(m·h)²`.
     pub impact_torque: Scale<8>,
-    /// Gain of the load filter, run on every other tick.
+    /// Gain of the load filter, run on every fourth tick.
     pub load_alpha: Gain,
     /// `T_drive + drag_allowance`: the pack torque above which a driving pack drags.
     pub drag_limit: Q16,
+    /// Largest step of the implied load against its recent history (N·m) while the drive
+    /// carries the load (`M = N + s·T_drive`: one N·m of drive torque is one N·m of load).
+    pub step_limit: Q16,
+    /// The same step of drive torque while overrunning, where the implied load `y(v) − v`
+    /// moves by `g₁ − 1` ≈ 5.9 N·m per N·m of drive torque.
+    pub step_limit_overrun: Q16,
+    /// Gain of the implied load's recent history, run on one tick in four.
+    pub step_alpha: Gain,
     pub load_known_ticks: u32,
+    /// Health change per update (Q16 bits; the update runs on one tick in four).
     pub health_step: i32,
     pub energy_per_tick: Scale<32>,
 }
@@ -663,7 +687,8 @@ impl Params {
         let current_off = positive(t.current_off_max_a, "thresholds.current_off_max_a")? / amps;
         let lost = positive(t.max_lost_motion_rad, "thresholds.max_lost_motion_rad")?;
         let energy = h * 256.0; // Q16 W → U40F24 J per tick: P·2^-16·h·2^24
-        let health_step = positive(t.health_rate_per_s, "thresholds.health_rate_per_s")? * h;
+                                // The health update runs on one tick in four: its step covers four.
+        let health_step = positive(t.health_rate_per_s, "thresholds.health_rate_per_s")? * 4.0 * h;
         if health_step >= 0.5 {
             return Err(ConfigError::OutOfRange {
                 parameter: "thresholds.health_rate_per_s",
@@ -720,6 +745,14 @@ impl Params {
             min_margin: scale(min_margin, "thresholds.min_capacity_margin")?,
             lock_dwell_ticks: ticks(t.lock_dwell_s, tick_hz, "thresholds.lock_dwell_s")?,
             braking_model_ticks: model_ticks(c.braking_model_hz, tick_hz)?,
+            braking_travel: scale(
+                h / out_rad * f64::from(model_ticks(c.braking_model_hz, tick_hz)?),
+                "braking_model_hz",
+            )?,
+            braking_speed: scale(
+                h / j * f64::from(model_ticks(c.braking_model_hz, tick_hz)?),
+                "braking_model_hz",
+            )?,
             // 100 Hz ≤ tick_hz ≤ 1 MHz and ticks ≥ 1: the rate fits a u32 (`as` is exact).
             braking_model_hz: (tick_hz / f64::from(model_ticks(c.braking_model_hz, tick_hz)?) + 0.5)
                 as u32,
@@ -765,16 +798,33 @@ impl Params {
             // 1e-3 rad/s per tick at 10 kHz, ≥ 1 LSB at any tick rate; `as` is exact here
             // (0 < value < 2^31 for any accepted tick rate).
             impact_decay: ((IMPACT_DECAY_RAD_S2 * h * Q16_ONE + 0.5) as i32).max(1),
-            // The load filter runs on every other tick (Monitor::step, "cost"): its gain is
-            // that of a filter sampled at tick_hz/2.
+            // The load filter runs on every fourth tick (Monitor::step, "cost"): its gain is
+            // that of a filter sampled at tick_hz/4.
             load_alpha: gain(
                 1.0 - exp_neg(
                     core::f64::consts::TAU
                         * positive(t.load_filter_hz, "thresholds.load_filter_hz")?
-                        * 2.0
+                        * 4.0
                         * h,
                 ),
                 "thresholds.load_filter_hz",
+            )?,
+            step_limit: q16(
+                positive(t.step_allowance_nm, "thresholds.step_allowance_nm")?,
+                "thresholds.step_allowance_nm",
+            )?,
+            step_alpha: gain(
+                1.0 - exp_neg(
+                    core::f64::consts::TAU
+                        * positive(t.step_reference_hz, "thresholds.step_reference_hz")?
+                        * 4.0
+                        * h,
+                ),
+                "thresholds.step_reference_hz",
+            )?,
+            step_limit_overrun: q16(
+                t.step_allowance_nm * (2.0 * a_k / (a_k - 1.0) - 1.0),
+                "thresholds.step_allowance_nm",
             )?,
             drag_limit: q16(
                 drive_drag + positive(t.drag_allowance_nm, "thresholds.drag_allowance_nm")?,

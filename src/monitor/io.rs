@@ -119,9 +119,11 @@ pub struct Flags {
     pub brake_slip: bool,
     /// Capacity margin below the limit, or braking time/angle beyond the envelope.
     pub brake_weak: bool,
-    /// Pack torque while driving beyond the allowance, or drive current above the model.
+    /// Pack torque while driving beyond the allowance, drive current above the model, or a
+    /// step up of the drive's work while driving (a drag that appears).
     pub brake_drag: bool,
-    /// Implausible encoder or current reading (jump, stuck counter, out-of-range code).
+    /// Implausible encoder or current reading (jump, stuck counter, out-of-range code, or a
+    /// step down of the current-implied drive work: a current reading that lost gain).
     pub sensor_fault: bool,
     /// A tick was missed.
     pub overrun: bool,

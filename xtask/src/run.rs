@@ -202,7 +202,11 @@ pub fn replay_report(
     let mut max_by_scene = serde_json::Map::new();
     for name in ["driving", "holding", "fault_braking", "overrunning"] {
         let ticks: f64 = field::<u32>(&scene_line, name)?.into();
-        max_by_scene.insert(name.into(), json!((ticks / per_insn).round()));
+        let at: u32 = field(&scene_line, &format!("{name}_at"))?;
+        max_by_scene.insert(
+            name.into(),
+            json!({"insns": (ticks / per_insn).round(), "at_step": at}),
+        );
     }
     let size = elf_size::of_file(&elf)?;
     let flash_bytes = size.flash_bytes.saturating_sub(bytes.len() as u64);

@@ -1,0 +1,132 @@
+//! The checks of a running drive, on one tick in four (ticks ≡ 1 mod 4; `Monitor::step`,
+//! "cost"): `brake_drag` when the pack drags beyond its allowance, and the step check that
+//! raises `brake_drag` or `sensor_fault` when the drive's work jumps.
+//!
+//! They live out of line (`#[inline(never)]`): the drive-off ticks — braking and holding, the
+//! monitor's worst case — then do not carry their registers (measured: +22 instructions on
+//! every tick they are not run on when inlined, `cargo xtask run --json`).
+//!
+//! | quantity | format | range | resolution |
+//! |---|---|---|---|
+//! | implied load, its history | [`Q16`], saturating | ±32 768 N·m | 1.5e-5 N·m |
+//! | persistence counters | `u32` ticks, saturating | — | 1 tick |
+
+use super::config::Params;
+use super::{signed, Flags};
+use crate::fx::{lowpass, Q16};
+
+/// State of the drive checks.
+#[derive(Clone, Copy, Debug, Default)]
+pub(crate) struct DriveChecks {
+    /// Ticks the pack has dragged beyond the allowance.
+    drag_ticks: u32,
+    /// Recent history (low-pass) of the current-implied load along the motion.
+    step_ref: Q16,
+    /// The history has been seeded in this phase of the drive.
+    step_ref_valid: bool,
+    /// Ticks the drive has worked harder than its history by more than the step limit.
+    step_up_ticks: u32,
+    /// Ticks it has seemed to work less (current reading low).
+    step_down_ticks: u32,
+}
+
+/// What the step knows of this tick.
+pub(crate) struct DriveTick {
+    /// Direction of the output (±1: moving).
+    pub s: i32,
+    /// Observer net torque `J_s·ω̇ − u` (N·m).
+    pub net: Q16,
+    /// The scene's pack torque magnitude: the drive drag, or the overrunning equilibrium.
+    pub pack: Q16,
+    /// Overrunning (the ramps engaged).
+    pub engaged: bool,
+    /// The drive carries the load (scene `Driving`).
+    pub carrying: bool,
+    /// The phase has lasted the observer's settling time: the step history may run.
+    pub history_ok: bool,
+    /// The load learned at the start of this drive, if any: the drag check's reference.
+    pub load_ref: Option<Q16>,
+    /// Ticks since the previous step.
+    pub ticks: u32,
+}
+
+impl DriveChecks {
+    /// Forgets the history and the persistence counts (drive off, output still, or a reset).
+    #[inline]
+    pub fn disarm(&mut self) {
+        *self = DriveChecks::default();
+    }
+
+    /// One run (one tick in four, `t.ticks` ticks since the last step, counted four times).
+    #[inline(never)]
+    pub fn run(&mut self, flags: &mut Flags, p: &Params, t: &DriveTick) {
+        let counted = t.ticks.saturating_mul(4);
+        // Steps of the drive's work: the load the current implies (the observer's net torque
+        // `J_s·ω̇ − u` with the pack model of the scene: drive drag, or the overrunning
+        // equilibrium), along the motion, against its recent history (a low-pass at
+        // `step_reference_hz`). A pack that starts to drag makes the drive push harder; a
+        // current reading that loses gain makes it seem to push less. Both are steps; a genuine
+        // load moves slower than the history follows, and accelerating the output is no step
+        // (the observer's net torque carries `J_s·ω̇`). Along the motion, `s·M` falls when the
+        // drive pushes harder while it carries the load, and rises while overrunning
+        // (`M = y(v) − v` grows with `v`, by `g₁ − 1` per N·m: the limit is scaled so that
+        // both readings allow the same step of drive torque). The observer's transient after a
+        // change of scene (its brake model jumps) lasts a few of its time constants: the
+        // history starts once the phase has lasted the settling time.
+        if t.history_ok {
+            let along = signed(t.s, t.net.saturating_add(signed(t.s, t.pack)));
+            if self.step_ref_valid {
+                let dev = along.saturating_sub(self.step_ref);
+                let (harder, lighter) = if t.engaged {
+                    let limit = p.step_limit_overrun;
+                    (dev > limit, dev < limit.saturating_neg())
+                } else {
+                    (dev < p.step_limit.saturating_neg(), dev > p.step_limit)
+                };
+                self.step_up_ticks = if harder {
+                    self.step_up_ticks.saturating_add(counted)
+                } else {
+                    0
+                };
+                self.step_down_ticks = if lighter {
+                    self.step_down_ticks.saturating_add(counted)
+                } else {
+                    0
+                };
+                if self.step_up_ticks >= p.persistence_ticks {
+                    flags.brake_drag = true;
+                }
+                if self.step_down_ticks >= p.persistence_ticks {
+                    flags.sensor_fault = true;
+                }
+                self.step_ref = lowpass(self.step_ref, along, p.step_alpha);
+            } else {
+                self.step_ref = along;
+                self.step_ref_valid = true;
+            }
+        } else {
+            self.step_ref_valid = false;
+            self.step_up_ticks = 0;
+            self.step_down_ticks = 0;
+        }
+        // Drag against the drive's start: the load the current implies with a nominal drag
+        // beyond the envelope, or the pack torque beyond the reference load by the allowance.
+        if t.carrying {
+            let implied = t.net.saturating_add(signed(t.s, p.drive_drag)); // load if drag nominal
+            let over_model = implied.saturating_abs() > p.max_load;
+            let excess = t
+                .load_ref
+                .is_some_and(|r| signed(t.s, r.saturating_sub(t.net)) > p.drag_limit);
+            self.drag_ticks = if over_model || excess {
+                self.drag_ticks.saturating_add(counted)
+            } else {
+                0
+            };
+            if self.drag_ticks >= p.persistence_ticks {
+                flags.brake_drag = true;
+            }
+        } else {
+            self.drag_ticks = 0;
+        }
+    }
+}
