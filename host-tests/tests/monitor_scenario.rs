@@ -15,7 +15,7 @@
 //! `noback::mechanism` and `noback::sensors` numbers (one source of truth for parameters).
 
 use noback::mechanism::{Mechanism, TABLE2};
-use noback::monitor::{BrakeState, Config, Estimate, Inputs, Monitor, Scene};
+use noback::monitor::{BrakeState, Config, Estimate, Flags, Inputs, Monitor, Scene};
 use noback::sensors::{SensorConfig, DEFAULT_SENSORS};
 
 const TICK_HZ: f64 = 10_000.0;
@@ -445,35 +445,45 @@ fn current_reading_losing_gain_mid_drive_raises_sensor_fault() {
     let (trace, at) = drive_with_a_change(-20.0, 5.0, |p, since| {
         p.current_gain = if since >= 0.0 { 0.5 } else { 1.0 };
     });
-    let before = trace.iter().rfind(|x| x.0 < at).unwrap().2;
-    assert!(!before.flags.any(), "{:?}", before.flags);
-    assert_eq!(before.scene, Scene::Driving);
-    let seen = first_time(&trace, |x| x.2.flags.sensor_fault).expect("sensor_fault");
-    println!("current gain 0.5 at {at} s: sensor_fault at {seen:.4} s");
-    assert!(seen > at && seen - at <= 0.05, "{seen}");
-    assert!(!trace.last().unwrap().2.flags.brake_drag);
+    flagged_within_50_ms(
+        &trace,
+        at,
+        Scene::Driving,
+        |f| f.sensor_fault,
+        |f| f.brake_drag,
+    );
 }
 
 #[test]
 fn pack_starting_to_drag_mid_drive_raises_brake_drag() {
     // 5 N·m more drag, below the 8 N·m allowance against the drive's start: only the step sees it.
-    for (load, speed) in [(-20.0, 5.0), (-10.0, -5.0)] {
+    for (load, speed, scene) in [
+        (-20.0, 5.0, Scene::Driving),
+        (-10.0, -5.0, Scene::Overrunning),
+    ] {
         let (trace, at) = drive_with_a_change(load, speed, |p, since| {
             p.extra_drag_nm = if since >= 0.0 { 5.0 } else { 0.0 };
         });
-        let before = trace.iter().rfind(|x| x.0 < at).unwrap().2;
-        assert!(!before.flags.any(), "{:?}", before.flags);
-        let expected_scene = if speed > 0.0 {
-            Scene::Driving
-        } else {
-            Scene::Overrunning
-        };
-        assert_eq!(before.scene, expected_scene);
-        let seen = first_time(&trace, |x| x.2.flags.brake_drag).expect("brake_drag");
-        println!("{expected_scene:?}: drag +5 N·m at {at} s: brake_drag at {seen:.4} s");
-        assert!(seen > at && seen - at <= 0.05, "{seen}");
-        assert!(!trace.last().unwrap().2.flags.sensor_fault);
+        flagged_within_50_ms(&trace, at, scene, |f| f.brake_drag, |f| f.sensor_fault);
     }
+}
+
+/// Before `at` the monitor is in `scene` with no flag; `wanted` rises within 50 ms after it and
+/// `other` never does.
+fn flagged_within_50_ms(
+    trace: &[(f64, f64, Estimate)],
+    at: f64,
+    scene: Scene,
+    wanted: impl Fn(&Flags) -> bool,
+    other: impl Fn(&Flags) -> bool,
+) {
+    let before = trace.iter().rfind(|x| x.0 < at).unwrap().2;
+    assert!(!before.flags.any(), "{:?}", before.flags);
+    assert_eq!(before.scene, scene);
+    let seen = first_time(trace, |x| wanted(&x.2.flags)).expect("the flag rises");
+    println!("{scene:?}: change at {at} s, flagged at {seen:.4} s");
+    assert!(seen > at && seen - at <= 0.05, "{seen}");
+    assert!(!other(&trace.last().unwrap().2.flags));
 }
 
 #[test]
