@@ -59,7 +59,7 @@
 //!
 //! # Cost
 //! `cargo xtask run --json` (Cortex-M3 under QEMU, the twin's reverse_load trace, release, LTO):
-//! mean 854.6, max 966 instructions per step (budget 1000; the worst step per scene is in the
+//! mean 867.5, max 983 instructions per step (budget 1000; the worst step per scene is in the
 //! command's `insns_per_step_max_by_scene`). The periodic parts (load filter or pack health,
 //! drive checks, friction energy, load-cache refresh) each have their own tick modulo 4, so
 //! that no step carries two of them (`step`, "Cost"; docs/monitor-design.md, "Cost").
@@ -166,6 +166,8 @@ pub struct Monitor {
     weak_ticks: u32,
     /// The drag and step checks of a running drive.
     drive_checks: DriveChecks,
+    /// Ticks of steady driving: the drive checks' settling.
+    drive_ticks: u32,
     health: Q16,
     energy: U40F24,
     /// Ticks since the friction energy was last sampled.
@@ -311,6 +313,7 @@ impl Monitor {
             still_motor: 0,
             weak_ticks: 0,
             drive_checks: DriveChecks::default(),
+            drive_ticks: 0,
             health: Q16::ONE,
             energy: U40F24::ZERO,
             energy_ticks: 0,
@@ -688,6 +691,11 @@ impl Monitor {
         } else {
             Scene::FaultBraking
         };
+        // A change between the two driving readings changes how the motion is read, not the
+        // motion: the observer's model takes it over bumplessly (below).
+        let reading_switch = drive
+            && matches!(self.scene, Scene::Driving | Scene::Overrunning)
+            && scene != self.scene;
         if scene != self.scene || engaged != self.engaged {
             self.phase_ticks = 0;
         } else {
@@ -867,6 +875,13 @@ impl Monitor {
                 self.creep_valid = false;
             }
         }
+        // Ticks of driving in motion: the drive checks' settling at the drive's start (a
+        // change of reading does not restart them: it is bumpless, below).
+        self.drive_ticks = if drive && s != 0 {
+            self.drive_ticks.saturating_add(n)
+        } else {
+            0
+        };
         if self.tick & 3 == 1 {
             if drive && moving_ok {
                 // Out of line: the drive-off ticks (braking, holding: the worst case) do not
@@ -884,7 +899,7 @@ impl Monitor {
                         },
                         engaged,
                         carrying: scene == Scene::Driving,
-                        history_ok: self.phase_ticks >= p.settle_ticks,
+                        history_ok: self.drive_ticks >= p.settle_ticks,
                         load_ref: self.load_ref_known.then_some(self.load_ref),
                         ticks: n,
                     },
@@ -973,10 +988,22 @@ impl Monitor {
         } else {
             capacity
         };
-        self.brake_model = table1(
+        let brake_model = table1(
             Q16::from_bits(self.obs.d).saturating_add(self.drive_torque),
             model_capacity,
         );
+        if reading_switch {
+            // Bumpless transfer: the modelled pack torque steps (drive drag ↔ overrunning
+            // equilibrium) and the disturbance state takes the same step, so that the net
+            // torque `d̂ + u − T̂` the observer predicts with is continuous (without it the
+            // observer rang for ≈ 50 ms after every change of reading). Saturating.
+            self.obs.d = self.obs.d.saturating_add(
+                brake_model
+                    .to_bits()
+                    .saturating_sub(self.brake_model.to_bits()),
+            );
+        }
+        self.brake_model = brake_model;
 
         // ---- Friction energy: slip power |T·ω| integrated (saturating; monotone), sampled on
         // ticks ≡ 2 mod 4 over the ticks since the last sample (2.5 kHz: a heat estimate; the

@@ -42,7 +42,8 @@ pub(crate) struct DriveTick {
     pub engaged: bool,
     /// The drive carries the load (scene `Driving`).
     pub carrying: bool,
-    /// The phase has lasted the observer's settling time: the step history may run.
+    /// The drive has run steadily (moving, either reading) for the observer's settling time:
+    /// the step history may run.
     pub history_ok: bool,
     /// The load learned at the start of this drive, if any: the drag check's reference.
     pub load_ref: Option<Q16>,
@@ -70,9 +71,11 @@ impl DriveChecks {
         // (the observer's net torque carries `J_s·ω̇`). Along the motion, `s·M` falls when the
         // drive pushes harder while it carries the load, and rises while overrunning
         // (`M = y(v) − v` grows with `v`, by `g₁ − 1` per N·m: the limit is scaled so that
-        // both readings allow the same step of drive torque). The observer's transient after a
-        // change of scene (its brake model jumps) lasts a few of its time constants: the
-        // history starts once the phase has lasted the settling time.
+        // both readings allow the same step of drive torque). The history starts once the drive
+        // has run for the observer's settling time. After a change of reading it is seeded
+        // afresh once the new phase has settled (`engage_settle_s`, 20 ms, when the caller runs
+        // the checks again): the observer needs no longer, since the monitor hands the modelled
+        // pack torque's step to it bumplessly.
         if t.history_ok {
             let along = signed(t.s, t.net.saturating_add(signed(t.s, t.pack)));
             if self.step_ref_valid {
