@@ -694,6 +694,7 @@ impl Params {
                 parameter: "thresholds.health_rate_per_s",
             });
         }
+        let braking_ticks = model_ticks(c.braking_model_hz, tick_hz)?;
         let impact_m = {
             let m = positive(t.impact_window_s, "thresholds.impact_window_s")? * tick_hz + 0.5;
             if !(1.0..32.0).contains(&m) {
@@ -744,18 +745,11 @@ impl Params {
             stick_speed: q16(stick, "thresholds.stick_speed_rad_s")?,
             min_margin: scale(min_margin, "thresholds.min_capacity_margin")?,
             lock_dwell_ticks: ticks(t.lock_dwell_s, tick_hz, "thresholds.lock_dwell_s")?,
-            braking_model_ticks: model_ticks(c.braking_model_hz, tick_hz)?,
-            braking_travel: scale(
-                h / out_rad * f64::from(model_ticks(c.braking_model_hz, tick_hz)?),
-                "braking_model_hz",
-            )?,
-            braking_speed: scale(
-                h / j * f64::from(model_ticks(c.braking_model_hz, tick_hz)?),
-                "braking_model_hz",
-            )?,
+            braking_model_ticks: braking_ticks,
+            braking_travel: scale(h / out_rad * f64::from(braking_ticks), "braking_model_hz")?,
+            braking_speed: scale(h / j * f64::from(braking_ticks), "braking_model_hz")?,
             // 100 Hz ≤ tick_hz ≤ 1 MHz and ticks ≥ 1: the rate fits a u32 (`as` is exact).
-            braking_model_hz: (tick_hz / f64::from(model_ticks(c.braking_model_hz, tick_hz)?) + 0.5)
-                as u32,
+            braking_model_hz: (tick_hz / f64::from(braking_ticks) + 0.5) as u32,
             persistence_ticks: ticks(
                 t.flag_persistence_s,
                 tick_hz,
