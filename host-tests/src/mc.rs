@@ -142,6 +142,21 @@ pub fn mirror(trace: &mut Trace, adc_bits: u8, motor_bits: u8, output_bits: u8) 
     }
 }
 
+/// The sensor trace of one draw: the twin's run of its scene, mirrored when the draw says so.
+pub fn draw_trace(d: &Draw) -> Result<Trace, String> {
+    let mut trace = scene_trace(&d.scene)?;
+    let s = &d.scene.sensors;
+    if d.mirrored {
+        mirror(
+            &mut trace,
+            s.current_adc_bits,
+            s.motor_counter_bits,
+            s.output_encoder_bits,
+        );
+    }
+    Ok(trace)
+}
+
 /// Runs one draw through the twin and the monitor.
 pub fn evaluate(d: &Draw) -> Outcome {
     let fault = d.scene.faults.first().copied();
@@ -152,19 +167,10 @@ pub fn evaluate(d: &Draw) -> Outcome {
         false_flags: 0,
         error: Some(e),
     };
-    let mut trace = match scene_trace(&d.scene) {
+    let trace = match draw_trace(d) {
         Ok(trace) => trace,
         Err(e) => return fail(e),
     };
-    let s = &d.scene.sensors;
-    if d.mirrored {
-        mirror(
-            &mut trace,
-            s.current_adc_bits,
-            s.motor_counter_bits,
-            s.output_encoder_bits,
-        );
-    }
     // The monitor is configured with the nominal Table 2, not the drawn mechanism: it must
     // cope with a ±10 % real part.
     let estimates = match run_monitor(&trace, Config::default()) {

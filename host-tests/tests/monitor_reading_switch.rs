@@ -4,23 +4,13 @@
 //! Without the bumpless transfer the observer rang after the change and the step check raised
 //! a false `brake_drag` at 0.158 s; with it the run is clean.
 
-use host_tests::accuracy::{compare, run_monitor, scene_trace};
-use host_tests::mc::{draw, mirror};
+use host_tests::accuracy::{compare, run_monitor};
+use host_tests::mc::{draw, draw_trace};
 use noback::monitor::{Config, Scene};
 
 #[test]
 fn a_change_of_reading_while_driving_raises_nothing() {
-    let d = draw(2026, 348, None);
-    let mut trace = scene_trace(&d.scene).expect("twin");
-    let s = &d.scene.sensors;
-    if d.mirrored {
-        mirror(
-            &mut trace,
-            s.current_adc_bits,
-            s.motor_counter_bits,
-            s.output_encoder_bits,
-        );
-    }
+    let trace = draw_trace(&draw(2026, 348, None)).expect("twin");
     let estimates = run_monitor(&trace, Config::default()).expect("monitor");
     // The run does change its driving reading (else it would not test the transfer).
     let mut changes = 0;
