@@ -75,6 +75,7 @@ mod drive_checks;
 mod io;
 mod observer;
 mod scale;
+mod slip_check;
 
 pub use config::{
     Config, ConfigError, ObserverGains, Thresholds, DEFAULT_BRAKING_MODEL_HZ,
@@ -88,6 +89,7 @@ use config::Params;
 use drive_checks::{DriveChecks, DriveTick};
 use fixed::types::U40F24;
 use observer::Observer;
+use slip_check::SlipCheck;
 
 /// Largest capacity margin reported (loads below `min_load_nm` report this).
 pub const MARGIN_MAX: Q16 = Q16::from_bits(1000 << 16);
@@ -161,6 +163,8 @@ pub struct Monitor {
     creep_counts: i32,
     creep_min: i32,
     creep_max: i32,
+    /// Both shafts carried the same way while the brake holds.
+    slip_check: SlipCheck,
     still_out: u32,
     still_motor: u32,
     weak_ticks: u32,
@@ -219,13 +223,24 @@ struct BrakingEnvelope {
     overdue_ticks: u32,
     /// Ticks since the nominal model's last step.
     model_ticks: u32,
+    /// Travel per tick at the cut speed (Q16 counts).
+    free_tick: i32,
+    /// Travel per usual model step at the cut speed (Q16 counts).
+    free_step: i32,
+    /// Travel at the cut speed, undecelerated, since the cut (Q16 counts, saturating).
+    free_counts: i32,
 }
 
 impl BrakingEnvelope {
-    /// Starts the envelope from the present output speed.
-    fn arm(&mut self, speed: Q16) {
+    /// Starts the envelope from the present output speed (`speed_to_counts`: Q16 rad/s → Q16
+    /// counts per tick; `model_ticks`: ticks per usual step of the nominal model).
+    fn arm(&mut self, speed: Q16, speed_to_counts: &Scale<28>, model_ticks: u32) {
+        let speed = speed.saturating_abs();
+        let free_tick = speed_to_counts.apply(speed.to_bits());
         *self = BrakingEnvelope {
-            expected_speed: speed.saturating_abs(),
+            expected_speed: speed,
+            free_tick,
+            free_step: free_tick.times(i32::try_from(model_ticks).unwrap_or(i32::MAX)),
             ..BrakingEnvelope::default()
         };
     }
@@ -309,6 +324,7 @@ impl Monitor {
             creep_counts: 0,
             creep_min: 0,
             creep_max: 0,
+            slip_check: SlipCheck::default(),
             still_out: 0,
             still_motor: 0,
             weak_ticks: 0,
@@ -381,6 +397,7 @@ impl Monitor {
         self.creep_counts = 0;
         self.creep_min = 0;
         self.creep_max = 0;
+        self.slip_check.restart(self.prev_out, self.prev_motor);
     }
 
     /// One tick: reads the raw inputs, advances the model, returns the estimate. Never panics;
@@ -562,6 +579,7 @@ impl Monitor {
         if fault {
             self.flags.sensor_fault = true;
             self.since_fault = 0;
+            self.slip_check.disarm(); // an implausible step is no travel
         } else {
             self.since_fault = self.since_fault.saturating_add(n);
         }
@@ -593,10 +611,12 @@ impl Monitor {
                 self.load_ref = self.load;
                 self.load_ref_known = self.load_known;
             } else {
-                self.envelope.arm(w);
+                self.envelope
+                    .arm(w, &p.speed_to_counts, p.braking_model_ticks);
                 self.creep_valid = false;
                 self.creep_counts = 0;
             }
+            self.slip_check.disarm();
             self.prev_drive = drive;
         }
 
@@ -671,6 +691,7 @@ impl Monitor {
                     self.creep_counts = 0;
                     self.creep_min = 0;
                     self.creep_max = 0;
+                    self.slip_check.arm(self.prev_out, self.prev_motor);
                 }
             }
         }
@@ -812,13 +833,15 @@ impl Monitor {
         // faces clamp) gives the expected speed and angle; the output may overrun them by the
         // allowances. (The twin's healthy pack stops on impact, far inside this envelope.)
         if scene == Scene::FaultBraking && !settled {
-            self.envelope.arm(w);
+            self.envelope
+                .arm(w, &p.speed_to_counts, p.braking_model_ticks);
         } else if scene == Scene::FaultBraking && out_ok {
             let env = &mut self.envelope;
             // The nominal braking model runs at its own rate (`braking_model_hz`, the
             // cheapest-per-scene table's choice): one explicit-Euler step over the ticks it
             // covers, travel with the old speed, then the speed.
             env.model_ticks = env.model_ticks.saturating_add(n);
+            env.counts = env.counts.saturating_add(d_out.saturating_abs());
             // On odd ticks only (the pack-health update takes the even ones).
             if env.model_ticks >= p.braking_model_ticks && !even_tick {
                 let decel = if s == load_sign {
@@ -830,10 +853,11 @@ impl Monitor {
                 // The usual step covers exactly `braking_model_ticks` ticks: its constants are
                 // precomputed; a longer one (a late tick, or the first step after an arm on an
                 // even tick) multiplies the per-tick ones.
-                let (travel, dv) = if env.model_ticks == p.braking_model_ticks {
+                let (travel, dv, free) = if env.model_ticks == p.braking_model_ticks {
                     (
                         p.braking_travel.apply(env.expected_speed.to_bits()),
                         p.braking_speed.apply(decel.to_bits()),
+                        env.free_step,
                     )
                 } else {
                     // ≤ 1000 + 256 ticks (reset at each model step): fits an i32.
@@ -843,14 +867,23 @@ impl Monitor {
                             .apply(env.expected_speed.to_bits())
                             .times(k),
                         p.obs.v_a.apply(decel.to_bits()).times(k),
+                        env.free_tick.times(k),
                     )
                 };
                 env.model_ticks = 0;
                 env.expected_counts = env.expected_counts.saturating_add(travel);
                 env.expected_speed =
                     Q16::from_bits(env.expected_speed.to_bits().saturating_sub(dv).max(0));
+                // A pack that does not brake: the output has gone further than it would at
+                // its cut speed (a working pack decelerates it from the first millisecond).
+                // Both sides < 2^48: exact in i64.
+                env.free_counts = env.free_counts.saturating_add(free);
+                if i64::from(env.counts) << 16
+                    > i64::from(env.free_counts) + i64::from(p.undecelerated_allowance)
+                {
+                    self.flags.brake_weak = true;
+                }
             }
-            env.counts = env.counts.saturating_add(d_out.saturating_abs());
             if env.expected_speed == Q16::ZERO {
                 env.overdue_ticks = env.overdue_ticks.saturating_add(n);
             }
@@ -874,6 +907,20 @@ impl Monitor {
                 self.locked = false;
                 self.creep_valid = false;
             }
+        }
+        // Common slip: both shafts carried the same way (slip_check.rs), on ticks ≡ 1 mod 4
+        // with the drive off (the drive checks take them with the drive on). Armed when the
+        // brake first holds, disarmed by the drive and by an implausible encoder step.
+        if !drive
+            && self.tick & 3 == 1
+            && self
+                .slip_check
+                .slipping(&p.slip, self.prev_out, self.prev_motor)
+        {
+            self.flags.brake_slip = true;
+            self.locked = false;
+            self.creep_valid = false;
+            self.slip_check.disarm();
         }
         // Ticks of driving in motion: the drive checks' settling at the drive's start (a
         // change of reading does not restart them: it is bumpless, below).

@@ -302,6 +302,36 @@ fn constructor_rejects_out_of_range_parameters() {
             parameter: "sensors.output_encoder_bits"
         }
     );
+    // The common-slip check measures travel on the wrapping counters: a limit of a quarter
+    // turn of the 14-bit output encoder (1.57 rad) or beyond cannot be resolved.
+    let mut c = Config::default();
+    c.thresholds.slip_output_travel_rad = 1.6;
+    assert_eq!(
+        err(c),
+        ConfigError::OutOfRange {
+            parameter: "thresholds.slip_output_travel_rad"
+        }
+    );
+    let mut c = Config::default();
+    c.thresholds.slip_input_travel_rad = -0.045;
+    assert_eq!(
+        err(c),
+        ConfigError::OutOfRange {
+            parameter: "thresholds.slip_input_travel_rad"
+        }
+    );
+    let mut c = Config::default();
+    c.thresholds.undecelerated_allowance_rad = 0.0;
+    assert_eq!(
+        err(c),
+        ConfigError::OutOfRange {
+            parameter: "thresholds.undecelerated_allowance_rad"
+        }
+    );
+    // Just inside the quarter turn: accepted.
+    let mut c = Config::default();
+    c.thresholds.slip_output_travel_rad = 1.5;
+    assert!(noback::monitor::Monitor::new(c).is_ok());
 }
 
 #[test]

@@ -13,7 +13,9 @@
 //! the next drive cut for holding faults, the running drive for drag), against issue 4's
 //! 50 ms.
 
-use host_tests::accuracy::{compare, detection_latency_s, run_monitor, scene_trace, Accuracy};
+use host_tests::accuracy::{
+    compare, detection_latency_s, manifest_time, run_monitor, scene_trace, Accuracy,
+};
 use noback::monitor::Config;
 use noback_twin::fault::{Fault, FaultKind};
 use noback_twin::reading::Reading;
@@ -177,6 +179,100 @@ fn dragging_pack_while_driving_raises_brake_drag() {
     assert!(latency.is_some_and(|l| l <= TARGET_S), "{latency:?}");
     assert!(
         acc.flags.iter().all(|f| f.flag == "brake_drag"),
+        "{:?}",
+        acc.flags
+    );
+}
+
+#[test]
+fn a_slow_slip_while_holding_is_seen_on_both_encoders_before_the_output_span_could_show_it() {
+    // A light held load (8.4 N·m) and a pack at 10 % of its friction: the output creeps away,
+    // and the input shaft is carried along with it (the connecting shaft turns). The output's
+    // span alone must exceed the rattle (`creep_limit_rad`, 0.15 rad); the common-slip check
+    // answers while the output has travelled less than that.
+    let fault = Fault {
+        kind: FaultKind::FrictionLoss,
+        at_s: 0.2,
+        severity: 0.9,
+    };
+    let mut scene = Scene::builtin(SceneKind::Hold, Reading::Physical);
+    scene.load_torque_nm = 8.4;
+    scene.faults.push(fault);
+    let trace = scene_trace(&scene).expect("twin");
+    let acc = compare(
+        &trace,
+        &run_monitor(&trace, Config::default()).expect("monitor"),
+    );
+    let manifest = manifest_time(&fault, &trace).expect("the pack slips");
+    let slip = flag_time(&acc, "brake_slip").expect("brake_slip");
+    let angle = |t: f64| {
+        trace
+            .rows
+            .iter()
+            .find(|r| r.t_s >= t)
+            .map_or(f64::NAN, |r| r.output_angle_rad)
+    };
+    let travel = (angle(slip) - angle(fault.at_s)).abs();
+    println!(
+        "hold 8.4 N·m, friction_loss 0.9: slipping from {manifest:.4} s, brake_slip at {slip:.4} s after {travel:.3} rad, flags {:?}",
+        acc.flags.iter().map(|f| (f.flag, f.t_s)).collect::<Vec<_>>()
+    );
+    assert!(slip - manifest <= TARGET_S, "{slip} vs {manifest}");
+    let creep_limit = Config::default().thresholds.creep_limit_rad;
+    assert!(
+        travel < creep_limit,
+        "{travel} rad: the span check could have fired"
+    );
+    assert!(
+        acc.flags.iter().all(|f| f.t_s >= fault.at_s),
+        "{:?}",
+        acc.flags
+    );
+}
+
+#[test]
+fn a_pack_that_lets_the_output_speed_up_after_the_cut_is_flagged_within_30_ms() {
+    // Forward load (20.3 N·m along the motion) on a pack at 30 % of its friction from 0.1 s:
+    // after the cut the pack's 18 N·m cannot stop the load, and the output speeds up. A working
+    // pack decelerates it from the first millisecond, so travel beyond the cut speed's is a
+    // brake that does not brake (the braking envelope's undecelerated check).
+    let fault = Fault {
+        kind: FaultKind::FrictionLoss,
+        at_s: 0.1,
+        severity: 0.7,
+    };
+    let (trace, acc) = run(SceneKind::ForwardLoad, Some(fault));
+    let cut = trace
+        .rows
+        .iter()
+        .find(|r| !r.drive_on)
+        .expect("the scene cuts the drive");
+    let weak = flag_time(&acc, "brake_weak").expect("brake_weak");
+    let speed_at = |t: f64| {
+        trace
+            .rows
+            .iter()
+            .find(|r| r.t_s >= t)
+            .map_or(f64::NAN, |r| r.output_speed_rad_s.abs())
+    };
+    println!(
+        "forward_load, friction_loss 0.7: cut {:.4} s at {:.2} rad/s, brake_weak {weak:.4} s at {:.2} rad/s, flags {:?}",
+        cut.t_s,
+        cut.output_speed_rad_s.abs(),
+        speed_at(weak),
+        acc.flags.iter().map(|f| (f.flag, f.t_s)).collect::<Vec<_>>()
+    );
+    assert!(
+        speed_at(weak) > cut.output_speed_rad_s.abs(),
+        "the output did not speed up: not this test's case"
+    );
+    assert!(
+        weak > cut.t_s && weak - cut.t_s <= 0.030,
+        "{weak} vs {}",
+        cut.t_s
+    );
+    assert!(
+        acc.flags.iter().all(|f| f.t_s >= cut.t_s),
         "{:?}",
         acc.flags
     );

@@ -2,6 +2,7 @@
 //! step uses ([`Params`]). Every division and unit conversion of the monitor happens here.
 
 use super::scale::{Scale, ScaleError};
+use super::slip_check::SlipLimits;
 use crate::fx::{Gain, Q16};
 use crate::mechanism::{Mechanism, TABLE2};
 use crate::sensors::{SensorConfig, DEFAULT_SENSORS};
@@ -100,6 +101,13 @@ pub struct Thresholds {
     pub lock_dwell_s: f64,
     /// Output travel allowed after the brake locked with the drive off (rad): `brake_slip`.
     pub creep_limit_rad: f64,
+    /// Common slip: output travel (rad) of a run that the input shaft follows the same way …
+    pub slip_output_travel_rad: f64,
+    /// … by more than this travel of the input shaft (rad, input side): `brake_slip`. Each
+    /// limit lies above what its shaft does alone while the pack holds (the rattle).
+    pub slip_input_travel_rad: f64,
+    /// Turn-back that ends a shaft's run in the common-slip check (rad, each shaft's side).
+    pub slip_reversal_rad: f64,
     /// Braking envelope, time: how long the output may keep moving (drive off) after the
     /// nominal model, started from the speed at the cut, has stopped it (s): `brake_weak`.
     pub braking_grace_s: f64,
@@ -108,6 +116,10 @@ pub struct Thresholds {
     pub braking_angle_factor: f64,
     /// … plus this allowance (rad), before `brake_weak`.
     pub braking_angle_allowance_rad: f64,
+    /// Braking envelope, a brake that does not brake: the output's travel since the cut may
+    /// exceed what it would cover at its cut speed, undecelerated, by this much (rad) before
+    /// `brake_weak` (a working pack decelerates it from the first millisecond).
+    pub undecelerated_allowance_rad: f64,
     /// Lowest capacity margin (capacity over |load|) before `brake_weak`.
     pub min_capacity_margin: f64,
     /// Loads below this (N·m) are too small for a margin or a load direction.
@@ -160,9 +172,13 @@ impl Thresholds {
         stick_speed_rad_s: 0.3,
         lock_dwell_s: 0.001,
         creep_limit_rad: 0.15,
+        slip_output_travel_rad: 0.05, // the output's rattle alone: ±0.13 rad
+        slip_input_travel_rad: 0.045, // the kicks alone: ≤ 0.035 rad; first false alarm at 0.03
+        slip_reversal_rad: 0.001,
         braking_grace_s: 0.4,
         braking_angle_factor: 2.0,
         braking_angle_allowance_rad: 0.1, // the twin's healthy pack stops within 0.07 rad
+        undecelerated_allowance_rad: 0.01,
         min_capacity_margin: 1.5,
         min_load_nm: 1.0,
         drag_allowance_nm: 8.0,
@@ -364,8 +380,11 @@ pub(crate) struct Params {
     pub engage_settle_ticks: u32,
     pub braking_grace_ticks: u32,
     pub creep_counts: i32,
+    pub slip: SlipLimits,
     pub braking_angle_factor: Scale<25>,
     pub braking_angle_allowance: i32,
+    /// Q16 output counts.
+    pub undecelerated_allowance: i32,
     pub speed_to_counts: Scale<28>,
     pub innovation_limit: i32,
     /// Q16 rad/s → angle words: the prediction error an impact reversing that speed can cause.
@@ -456,6 +475,18 @@ fn counts(x: f64, parameter: &'static str) -> Result<i32, ConfigError> {
         return Err(ConfigError::Overflow { parameter });
     }
     Ok(((x + 0.5) as i32).max(1))
+}
+
+/// A travel limit the common-slip check can measure on a wrapping counter: below a quarter of
+/// its range, so that the travel since the brake held (up to twice the limit before the check
+/// flags) stays within the half range its wrapping difference resolves.
+fn within_half_counter(limit: i32, bits: u8, parameter: &'static str) -> Result<i32, ConfigError> {
+    let quarter = 1_i64 << (u32::from(bits.clamp(2, 32)) - 2);
+    if i64::from(limit) < quarter {
+        Ok(limit)
+    } else {
+        Err(ConfigError::OutOfRange { parameter })
+    }
 }
 
 /// Ticks per step of the fault-braking model: `tick_hz / braking_model_hz`, a whole number from
@@ -762,6 +793,34 @@ impl Params {
                 positive(t.creep_limit_rad, "thresholds.creep_limit_rad")? / out_rad,
                 "thresholds.creep_limit_rad",
             )?,
+            slip: SlipLimits {
+                out_counts: within_half_counter(
+                    counts(
+                        t.slip_output_travel_rad / out_rad,
+                        "thresholds.slip_output_travel_rad",
+                    )?,
+                    s.output_encoder_bits,
+                    "thresholds.slip_output_travel_rad",
+                )?,
+                motor_counts: within_half_counter(
+                    counts(
+                        t.slip_input_travel_rad / in_rad,
+                        "thresholds.slip_input_travel_rad",
+                    )?,
+                    s.motor_counter_bits,
+                    "thresholds.slip_input_travel_rad",
+                )?,
+                out_hysteresis: counts(
+                    t.slip_reversal_rad / out_rad,
+                    "thresholds.slip_reversal_rad",
+                )?,
+                motor_hysteresis: counts(
+                    t.slip_reversal_rad / in_rad,
+                    "thresholds.slip_reversal_rad",
+                )?,
+                out_bits: s.output_encoder_bits,
+                motor_bits: s.motor_counter_bits,
+            },
             braking_angle_factor: scale(
                 positive(t.braking_angle_factor, "thresholds.braking_angle_factor")?,
                 "thresholds.braking_angle_factor",
@@ -774,6 +833,14 @@ impl Params {
                 )? / out_rad
                     * Q16_ONE,
                 "thresholds.braking_angle_allowance_rad",
+            )?,
+            undecelerated_allowance: counts(
+                positive(
+                    t.undecelerated_allowance_rad,
+                    "thresholds.undecelerated_allowance_rad",
+                )? / out_rad
+                    * Q16_ONE,
+                "thresholds.undecelerated_allowance_rad",
             )?,
             // Q16 rad/s → Q16 output counts per tick.
             speed_to_counts: scale(h / out_rad, "sensors.output_encoder_bits")?,
