@@ -729,12 +729,12 @@ impl Monitor {
         // ---- Load: learned where well conditioned, held elsewhere.
         // (No learning while a change of the driving reading is pending: the pack torque it
         // would use is the one being left.)
-        let moving_ok = settled
-            && sensors_ok
-            && s != 0
-            && !self.locked
-            && phase_settled
-            && self.reading_ticks == 0;
+        // The drive checks (below) keep their sensor half running while a change of reading is
+        // pending: a current reading that loses its gain can make the other reading look
+        // possible, and waiting for the switch would re-seed their history past the step (test
+        // `current_reading_losing_most_of_its_gain_is_flagged_before_the_reading_can_change`).
+        let checks_ok = settled && sensors_ok && s != 0 && !self.locked && phase_settled;
+        let moving_ok = checks_ok && self.reading_ticks == 0;
         // Cost: the periodic work is spread over the ticks so that no step carries two of the
         // expensive parts. Tick modulo 4 — 0: the load filter (drive on) or the pack-health
         // update (drive off); 1: the drive checks (drive on); 2: the friction energy; 3: the
@@ -930,7 +930,7 @@ impl Monitor {
             0
         };
         if self.tick & 3 == 1 {
-            if drive && moving_ok {
+            if drive && checks_ok {
                 // Out of line: the drive-off ticks (braking, holding: the worst case) do not
                 // carry these checks' registers.
                 self.drive_checks.run(
@@ -948,6 +948,7 @@ impl Monitor {
                         carrying: scene == Scene::Driving,
                         history_ok: self.drive_ticks >= p.settle_ticks,
                         load_ref: self.load_ref_known.then_some(self.load_ref),
+                        pending: self.reading_ticks != 0,
                         ticks: n,
                     },
                 );

@@ -47,6 +47,9 @@ pub(crate) struct DriveTick {
     pub history_ok: bool,
     /// The load learned at the start of this drive, if any: the drag check's reference.
     pub load_ref: Option<Q16>,
+    /// A change of reading is pending: only a current reading that lost its gain is looked
+    /// for (against the history as it stood), the rest waits for the reading to settle.
+    pub pending: bool,
     /// Ticks since the previous step.
     pub ticks: u32,
 }
@@ -86,7 +89,7 @@ impl DriveChecks {
                 } else {
                     (dev < p.step_limit.saturating_neg(), dev > p.step_limit)
                 };
-                self.step_up_ticks = if harder {
+                self.step_up_ticks = if harder && !t.pending {
                     self.step_up_ticks.saturating_add(counted)
                 } else {
                     0
@@ -102,7 +105,9 @@ impl DriveChecks {
                 if self.step_down_ticks >= p.persistence_ticks {
                     flags.sensor_fault = true;
                 }
-                self.step_ref = lowpass(self.step_ref, along, p.step_alpha);
+                if !t.pending {
+                    self.step_ref = lowpass(self.step_ref, along, p.step_alpha);
+                }
             } else {
                 self.step_ref = along;
                 self.step_ref_valid = true;
@@ -114,7 +119,7 @@ impl DriveChecks {
         }
         // Drag against the drive's start: the load the current implies with a nominal drag
         // beyond the envelope, or the pack torque beyond the reference load by the allowance.
-        if t.carrying {
+        if t.carrying && !t.pending {
             let implied = t.net.saturating_add(signed(t.s, p.drive_drag)); // load if drag nominal
             let over_model = implied.saturating_abs() > p.max_load;
             let excess = t
