@@ -85,7 +85,7 @@ pub use io::{BrakeState, Estimate, Flags, Inputs, Scene, SceneModel, ESTIMATE_WO
 pub use scale::{recip_q16, sat_i32, Scale, ScaleError};
 
 use crate::fx::{adc_centered, counter_delta, lowpass, Q16};
-use config::Params;
+use config::{Params, SYNC_WINDOW_TICKS};
 use drive_checks::{DriveChecks, DriveTick};
 use fixed::types::U40F24;
 use observer::Observer;
@@ -111,6 +111,10 @@ const POSITION_HISTORY: usize = 64;
 
 /// The tick (modulo 16) on which a changed load refreshes the load cache.
 const REFRESH_PHASE: u32 = 3;
+
+/// The tick (modulo [`SYNC_WINDOW_TICKS`]) on which the shafts' synchronism is measured: ≡ 3
+/// mod 4 like the refresh, which it never meets.
+const SYNC_PHASE: u32 = 7;
 
 /// Pack health is kept within [0, 2].
 const HEALTH_MAX: i32 = 2 << 16;
@@ -159,6 +163,9 @@ pub struct Monitor {
     position_head: usize,
     /// Consecutive on-time ticks with a plausible output encoder in the history.
     position_ticks: u32,
+    /// Output and motor counters at the last synchronism sample.
+    sync_out: u32,
+    sync_motor: u32,
     creep_valid: bool,
     creep_counts: i32,
     creep_min: i32,
@@ -320,6 +327,8 @@ impl Monitor {
             positions: [0; POSITION_HISTORY],
             position_head: 0,
             position_ticks: 0,
+            sync_out: 0,
+            sync_motor: 0,
             creep_valid: false,
             creep_counts: 0,
             creep_min: 0,
@@ -445,6 +454,8 @@ impl Monitor {
             self.started = true;
             self.prev_out = out_now;
             self.prev_motor = motor_now;
+            self.sync_out = out_now;
+            self.sync_motor = motor_now;
             self.prev_drive = !drive; // forces the drive-edge bookkeeping below
             self.obs = Observer {
                 theta: measured,
@@ -540,21 +551,17 @@ impl Monitor {
         let settled = self.settle_ticks >= p.settle_ticks;
         // Shortest signed angle (wrapping on purpose: the encoder is modular).
         let innovation = measured.wrapping_sub(self.obs.theta) as i32;
-        // Plausible prediction error: one tick at the fastest speed, plus, with the drive off,
-        // an impact in the lost motion reversing the recent peak speed within `impact_time_s`
-        // (the twin's output stops on impact within 2–10 ms and rattles at up to ±8 rad/s).
+        // Plausible prediction error: one tick at the fastest speed, plus an impact in the lost
+        // motion reversing the recent peak speed within `impact_time_s` (the twin's output
+        // stops on impact within 2–10 ms of a cut and rattles at up to ±8 rad/s; with the drive
+        // on, overrunning chatter reverses it at 7 rad/s after 570 N·m impacts).
         // The peak decays at IMPACT_DECAY_RAD_S2 (saturating: it never goes below 0 nor
         // wraps). The widened limit is only formed when the base limit is exceeded (cheaper on
         // every other tick).
-        if drive {
-            // Driving: no impacts; the peak restarts from the speed at the next cut.
-            self.impact_speed = 0;
-        } else {
-            self.impact_speed = self
-                .impact_speed
-                .saturating_sub(p.impact_decay.times(n_i))
-                .max(self.obs.v.saturating_abs());
-        }
+        self.impact_speed = self
+            .impact_speed
+            .saturating_sub(p.impact_decay.times(n_i))
+            .max(self.obs.v.saturating_abs());
         let base_limit = p.innovation_limit.times(n_i);
         let implausible = settled
             && innovation.saturating_abs() > base_limit
@@ -617,6 +624,7 @@ impl Monitor {
                 self.creep_counts = 0;
             }
             self.slip_check.disarm();
+            self.drive_ticks = 0;
             self.prev_drive = drive;
         }
 
@@ -743,7 +751,14 @@ impl Monitor {
         // periodic part counts the ticks it covers; time constants and persistence are those
         // of the tick rate.
         let even_tick = self.tick & 1 == 0;
-        if moving_ok && drive && self.tick & 3 == 0 {
+        // While driving, the load is learned only once the output has moved with the input
+        // shaft for the engage settling time, and the drive checks run (below) only after the
+        // observer's settling time of it (`drive_ticks`, below): an output that runs away from
+        // the input, or bounces in its lost motion (overrunning chatter), is where neither the
+        // drive torque nor the pack torque is quasi-static. (Learning keeps the acceleration of
+        // a drive's start, which tells the two driving readings apart.)
+        let steady_drive = self.drive_ticks >= p.settle_ticks;
+        if moving_ok && drive && self.drive_ticks >= p.engage_settle_ticks && self.tick & 3 == 0 {
             // The pack torque is known while the drive runs: the drive drag when the drive
             // carries the load, the overrunning equilibrium when the load runs along:
             // M = N + s·T_pack.
@@ -922,15 +937,37 @@ impl Monitor {
             self.creep_valid = false;
             self.slip_check.disarm();
         }
-        // Ticks of driving in motion: the drive checks' settling at the drive's start (a
-        // change of reading does not restart them: it is bumpless, below).
-        self.drive_ticks = if drive && s != 0 {
-            self.drive_ticks.saturating_add(n)
-        } else {
-            0
-        };
+        // Ticks of steady driving: the output moving with the input shaft (within
+        // `sync_speed_band`), the drive checks' and the load learning's settling at the
+        // drive's start (a change of reading does not restart them: it is bumpless, below).
+        // An output that runs away from the input — crossing its lost motion at a start, or
+        // bouncing in it (overrunning chatter: the ramps engage, the pack clamps, the output
+        // rebounds) — restarts them.
+        // Measured on the counters, not on the observer (whose speed leaves the measurement
+        // for a while when the model's torque steps): the travel of both shafts over the last
+        // `SYNC_WINDOW_TICKS`, on one tick in 16 that carries no other periodic work.
+        // `drive_ticks` is kept on that tick too (in steps of the window; the drive edge zeroes
+        // it), so that the other ticks carry none of this.
+        if drive && self.tick & (SYNC_WINDOW_TICKS - 1) == SYNC_PHASE {
+            let d_o = counter_delta(self.sync_out, out_now, p.out_bits);
+            let d_m = counter_delta(self.sync_motor, motor_now, p.motor_bits);
+            self.sync_out = out_now;
+            self.sync_motor = motor_now;
+            let synchronous = p
+                .motor_to_out
+                .apply(d_m)
+                .saturating_sub(d_o)
+                .saturating_abs()
+                <= p.sync_band_counts;
+            self.drive_ticks = if s != 0 && synchronous {
+                self.drive_ticks
+                    .saturating_add(n.saturating_mul(SYNC_WINDOW_TICKS))
+            } else {
+                0
+            };
+        }
         if self.tick & 3 == 1 {
-            if drive && checks_ok {
+            if drive && checks_ok && steady_drive {
                 // Out of line: the drive-off ticks (braking, holding: the worst case) do not
                 // carry these checks' registers.
                 self.drive_checks.run(
@@ -939,6 +976,7 @@ impl Monitor {
                     &DriveTick {
                         s,
                         net,
+                        drive: v,
                         pack: if engaged {
                             overrun_torque
                         } else {
@@ -946,7 +984,6 @@ impl Monitor {
                         },
                         engaged,
                         carrying: scene == Scene::Driving,
-                        history_ok: self.drive_ticks >= p.settle_ticks,
                         load_ref: self.load_ref_known.then_some(self.load_ref),
                         pending: self.reading_ticks != 0,
                         ticks: n,

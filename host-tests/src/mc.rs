@@ -1,7 +1,8 @@
 //! Monte Carlo of the monitor's detection: many twin scenes, nominal and faulty, each replayed
 //! through the shipped monitor on the host.
 //!
-//! Nominal draws: a braking, holding or driving scene (reverse_load, forward_load, hold, drive)
+//! Nominal draws: a braking, holding or driving scene (reverse_load, forward_load, hold, drive,
+//! continuous_closing)
 //! with load 5–30 N·m, speed 5–20 rad/s, every mechanism parameter of Table 2 scaled by an
 //! independent factor in [0.9, 1.1], current noise 0–0.1 A, and the load in either direction
 //! (a mirrored run: every sensor reading negated, which is the mechanism's symmetry).
@@ -88,19 +89,31 @@ fn scale_all(m: &mut Mechanism, rng: &mut Rng) {
     s(&mut m.restitution);
 }
 
+/// The scene kinds of the nominal and fault draws.
+pub const SCENE_KINDS: [SceneKind; 5] = [
+    SceneKind::ReverseLoad,
+    SceneKind::ForwardLoad,
+    SceneKind::Hold,
+    SceneKind::Drive,
+    SceneKind::ContinuousClosing,
+];
+
 /// Draws run `index` of a campaign: deterministic in (`seed`, `index`, `fault`).
 pub fn draw(seed: u64, index: u64, fault: Option<FaultKind>) -> Draw {
+    draw_among(&SCENE_KINDS, seed, index, fault)
+}
+
+/// [`draw`] with the scene kind drawn among `kinds` (the campaigns before continuous closing
+/// joined drew among the first four: their draws are reproduced with `&SCENE_KINDS[..4]`).
+pub fn draw_among(kinds: &[SceneKind], seed: u64, index: u64, fault: Option<FaultKind>) -> Draw {
     let salt = fault.map_or(0, |k| {
         1 + FAULT_KINDS.iter().position(|f| *f == k).unwrap_or(0) as u64
     });
     let mut rng = Rng::new(seed ^ index.wrapping_mul(0x9E37_79B9_7F4A_7C15) ^ (salt << 56));
-    let kinds = [
-        SceneKind::ReverseLoad,
-        SceneKind::ForwardLoad,
-        SceneKind::Hold,
-        SceneKind::Drive,
-    ];
-    let kind = kinds[(rng.next_u64() % kinds.len() as u64) as usize];
+    let kind = kinds
+        .get((rng.next_u64() % kinds.len().max(1) as u64) as usize)
+        .copied()
+        .unwrap_or(SceneKind::Hold);
     let mut scene = Scene::builtin(kind, Reading::Physical);
     scene.name = format!("mc-{index}");
     scene.load_torque_nm = 5.0 + 25.0 * rng.uniform();

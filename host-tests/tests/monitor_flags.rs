@@ -51,12 +51,14 @@ fn out_of_range_adc_code_latches_sensor_fault_until_reset() {
 fn adc_stuck_at_a_rail_is_a_sensor_fault_but_a_single_rail_sample_is_not() {
     let mut m = Monitor::new(Config::default()).unwrap();
     at_rest(&mut m, 0, 0, 100);
-    let e = m.step(&Inputs::new(0, 0, 0, true));
-    assert!(!e.flags.sensor_fault);
-    let mut e = e;
-    for _ in 0..30 {
-        e = m.step(&Inputs::new(0, 0, 0, true));
+    // The rail must last `adc_rail_time_s` (10 ms: the motor stalls at the current limit for
+    // ≈ 3 ms in overrunning chatter, reading the rail with the encoder still).
+    let rail_ticks = (Config::default().thresholds.adc_rail_time_s * 10_000.0).round() as usize;
+    for k in 1..rail_ticks {
+        let e = m.step(&Inputs::new(0, 0, 0, true));
+        assert!(!e.flags.sensor_fault, "after {k} ticks at the rail");
     }
+    let e = m.step(&Inputs::new(0, 0, 0, true));
     assert!(e.flags.sensor_fault);
 }
 

@@ -133,6 +133,10 @@ pub struct Thresholds {
     pub step_allowance_nm: f64,
     /// Corner frequency of the implied load's recent history (Hz).
     pub step_reference_hz: f64,
+    /// The output moves with the input shaft while their speeds differ by at most this
+    /// (rad/s): the quasi-static readings of a drive hold only then (learning the load, the
+    /// drive checks).
+    pub sync_speed_band_rad_s: f64,
     /// A brake condition must persist this long before its flag latches (s).
     pub flag_persistence_s: f64,
     /// Observer settling time after power-on or re-initialisation (s); untrusted meanwhile.
@@ -184,6 +188,7 @@ impl Thresholds {
         drag_allowance_nm: 8.0,
         step_allowance_nm: 2.5,
         step_reference_hz: 5.0,
+        sync_speed_band_rad_s: 1.0,
         flag_persistence_s: 0.01,
         settle_time_s: 0.1,
         engage_settle_s: 0.02,
@@ -193,7 +198,7 @@ impl Thresholds {
         max_motor_speed_rad_s: 1800.0,
         max_lost_motion_rad: 0.2, // the twin's lost motion is 0.03–0.1 rad
         current_off_max_a: 3.0,
-        adc_rail_time_s: 0.002,
+        adc_rail_time_s: 0.01, // overrunning chatter stalls the motor at the current limit ≈ 3 ms
         health_rate_per_s: 25.0,
         impact_time_s: 0.01,
         impact_window_s: 0.0016,
@@ -407,6 +412,10 @@ pub(crate) struct Params {
     pub step_limit_overrun: Q16,
     /// Gain of the implied load's recent history, run on one tick in four.
     pub step_alpha: Gain,
+    /// Output counts of relative travel over [`SYNC_WINDOW_TICKS`] within the band.
+    pub sync_band_counts: i32,
+    /// Motor counts → output counts (input shaft and output turn alike when synchronous).
+    pub motor_to_out: Scale<30>,
     pub load_known_ticks: u32,
     /// Health change per update (Q16 bits; the update runs on one tick in four).
     pub health_step: i32,
@@ -476,6 +485,10 @@ fn counts(x: f64, parameter: &'static str) -> Result<i32, ConfigError> {
     }
     Ok(((x + 0.5) as i32).max(1))
 }
+
+/// Ticks over which the output's and the input shaft's travel are compared for synchronism
+/// (`Monitor::step`, "steady driving").
+pub(crate) const SYNC_WINDOW_TICKS: u32 = 16;
 
 /// A travel limit the common-slip check can measure on a wrapping counter: below a quarter of
 /// its range, so that the travel since the brake held (up to twice the limit before the check
@@ -874,6 +887,11 @@ impl Params {
                 positive(t.step_allowance_nm, "thresholds.step_allowance_nm")?,
                 "thresholds.step_allowance_nm",
             )?,
+            sync_band_counts: counts(
+                t.sync_speed_band_rad_s * f64::from(SYNC_WINDOW_TICKS) * h / out_rad,
+                "thresholds.sync_speed_band_rad_s",
+            )?,
+            motor_to_out: scale(in_rad / out_rad, "sensors.motor_encoder_counts_per_rev")?,
             step_alpha: gain(
                 1.0 - exp_neg(
                     core::f64::consts::TAU

@@ -22,6 +22,8 @@ pub(crate) struct DriveChecks {
     drag_ticks: u32,
     /// Recent history (low-pass) of the current-implied load along the motion.
     step_ref: Q16,
+    /// Recent history (the same low-pass) of the drive torque along the motion.
+    drive_ref: Q16,
     /// The history has been seeded in this phase of the drive.
     step_ref_valid: bool,
     /// Ticks the drive has worked harder than its history by more than the step limit.
@@ -36,15 +38,14 @@ pub(crate) struct DriveTick {
     pub s: i32,
     /// Observer net torque `J_s·ω̇ − u` (N·m).
     pub net: Q16,
+    /// Drive torque along the motion, from the current (N·m).
+    pub drive: Q16,
     /// The scene's pack torque magnitude: the drive drag, or the overrunning equilibrium.
     pub pack: Q16,
     /// Overrunning (the ramps engaged).
     pub engaged: bool,
     /// The drive carries the load (scene `Driving`).
     pub carrying: bool,
-    /// The drive has run steadily (moving, either reading) for the observer's settling time:
-    /// the step history may run.
-    pub history_ok: bool,
     /// The load learned at the start of this drive, if any: the drag check's reference.
     pub load_ref: Option<Q16>,
     /// A change of reading is pending: only a current reading that lost its gain is looked
@@ -75,47 +76,63 @@ impl DriveChecks {
         // drive pushes harder while it carries the load, and rises while overrunning
         // (`M = y(v) − v` grows with `v`, by `g₁ − 1` per N·m: the limit is scaled so that
         // both readings allow the same step of drive torque). The history starts once the drive
-        // has run for the observer's settling time. After a change of reading it is seeded
+        // has run steadily (the output with the input shaft) for the observer's settling time:
+        // the caller runs the checks only then and disarms them otherwise. After a change of reading it is seeded
         // afresh once the new phase has settled (`engage_settle_s`, 20 ms, when the caller runs
         // the checks again): the observer needs no longer, since the monitor hands the modelled
         // pack torque's step to it bumplessly.
-        if t.history_ok {
-            let along = signed(t.s, t.net.saturating_add(signed(t.s, t.pack)));
-            if self.step_ref_valid {
-                let dev = along.saturating_sub(self.step_ref);
-                let (harder, lighter) = if t.engaged {
-                    let limit = p.step_limit_overrun;
-                    (dev > limit, dev < limit.saturating_neg())
-                } else {
-                    (dev < p.step_limit.saturating_neg(), dev > p.step_limit)
-                };
-                self.step_up_ticks = if harder && !t.pending {
-                    self.step_up_ticks.saturating_add(counted)
-                } else {
-                    0
-                };
-                self.step_down_ticks = if lighter {
-                    self.step_down_ticks.saturating_add(counted)
-                } else {
-                    0
-                };
-                if self.step_up_ticks >= p.persistence_ticks {
-                    flags.brake_drag = true;
-                }
-                if self.step_down_ticks >= p.persistence_ticks {
-                    flags.sensor_fault = true;
-                }
-                if !t.pending {
-                    self.step_ref = lowpass(self.step_ref, along, p.step_alpha);
-                }
+        let along = signed(t.s, t.net.saturating_add(signed(t.s, t.pack)));
+        if self.step_ref_valid {
+            let dev = along.saturating_sub(self.step_ref);
+            let (harder, lighter) = if t.engaged {
+                let limit = p.step_limit_overrun;
+                (dev > limit, dev < limit.saturating_neg())
             } else {
-                self.step_ref = along;
-                self.step_ref_valid = true;
+                (dev < p.step_limit.saturating_neg(), dev > p.step_limit)
+            };
+            // Both faults move the current itself: a drag makes the drive push harder
+            // (the speed loop answers the extra pack torque), a reading that loses gain
+            // reads lower. The mechanism's own torque swings — the pack engaging and
+            // letting go while overrunning, tens of N·m for tens of ms with the speed held
+            // within a rad/s — move the implied load through `J_s·ω̇` and leave the
+            // current alone. So the drive torque must have stepped the same way by at
+            // least half the allowance (a pure current step moves the implied load by the
+            // full step, or `g₁ − 1` times it while overrunning).
+            let drive_step = t.drive.saturating_sub(self.drive_ref);
+            let half = Q16::from_bits(p.step_limit.to_bits() >> 1);
+            let (harder, lighter) = (
+                harder && drive_step > half,
+                lighter && drive_step < half.saturating_neg(),
+            );
+            self.step_up_ticks = if harder && !t.pending {
+                self.step_up_ticks.saturating_add(counted)
+            } else {
+                0
+            };
+            self.step_down_ticks = if lighter {
+                self.step_down_ticks.saturating_add(counted)
+            } else {
+                0
+            };
+            if self.step_up_ticks >= p.persistence_ticks {
+                flags.brake_drag = true;
+            }
+            if self.step_down_ticks >= p.persistence_ticks {
+                flags.sensor_fault = true;
+            }
+            if !t.pending {
+                self.step_ref = lowpass(self.step_ref, along, p.step_alpha);
+                // A shift for the gain (1/64 per run at 2.5 kHz: a 6.2 Hz corner, near the
+                // implied load's 5 Hz): the direction of a step needs no more, and it is
+                // cheaper than the multiply on the drive checks' tick, the drive's worst.
+                self.drive_ref = self.drive_ref.saturating_add(Q16::from_bits(
+                    (t.drive.saturating_sub(self.drive_ref)).to_bits() >> 6,
+                ));
             }
         } else {
-            self.step_ref_valid = false;
-            self.step_up_ticks = 0;
-            self.step_down_ticks = 0;
+            self.step_ref = along;
+            self.drive_ref = t.drive;
+            self.step_ref_valid = true;
         }
         // Drag against the drive's start: the load the current implies with a nominal drag
         // beyond the envelope, or the pack torque beyond the reference load by the allowance.

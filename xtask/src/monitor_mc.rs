@@ -231,8 +231,10 @@ fn doc(a: &Args, r: &serde_json::Value) -> String {
          - Every run: a twin scene (physical reading) → its 10 kHz sensor trace (quantised, with \
          current noise) → the shipped monitor, configured with the nominal Table 2, stepped on \
          the host (bit-identical to the Cortex-M targets: `cargo xtask run` checks it).\n\
-         - Nominal draws: reverse_load, forward_load, hold or drive; load 5–30 N·m; speed 5–20 \
-         rad/s; drive cut at 0.1–0.3 s; every Table 2 parameter scaled by its own factor in \
+         - Nominal draws: reverse_load, forward_load, hold, drive or continuous_closing (the \
+         door closing under its load, the drive on throughout: overrunning, often with the \
+         pack's engagement chatter); load 5–30 N·m; speed 5–20 rad/s (the input's, in \
+         continuous_closing); drive cut at 0.1–0.3 s; every Table 2 parameter scaled by its own factor in \
          [0.9, 1.1]; current noise 0–0.1 A; the load in either direction (a mirrored run negates \
          every sensor reading). Any flag in a nominal run is a false alarm.\n\
          - Fault draws: the same plus one fault, onset uniform over the scene, severity \
