@@ -449,8 +449,8 @@ fn drive_with_a_change_at(
 fn current_reading_losing_gain_mid_drive_raises_sensor_fault() {
     // Half the current lost (severity 0.5, the smallest the Monte Carlo draws) while the drive
     // carries a 20 N·m load: the drive torque seems to fall by 11 N·m at once. (Overrunning,
-    // the drive torque is 2–4 N·m and half of it is below the step allowance: docs/monitor.md
-    // counts those misses.)
+    // the drive torque is 2–4 N·m and half of it is near the 1.25 N·m step allowance:
+    // docs/monitor.md counts those misses.)
     let (trace, at) = drive_with_a_change(-20.0, 5.0, |p, since| {
         p.current_gain = if since >= 0.0 { 0.5 } else { 1.0 };
     });
