@@ -177,7 +177,9 @@ pub struct Monitor {
     weak_ticks: u32,
     /// The drag and step checks of a running drive.
     drive_checks: DriveChecks,
-    /// Ticks of steady driving: the drive checks' settling.
+    /// Ticks of steady driving (the output moving with the input shaft), counted in steps of
+    /// `SYNC_WINDOW_TICKS` on the synchronism tick: the load learning's and the drive checks'
+    /// settling.
     drive_ticks: u32,
     health: Q16,
     energy: U40F24,

@@ -42,6 +42,14 @@ pub fn scene_trace(scene: &noback_twin::scene::Scene) -> Result<Trace, String> {
     ))
 }
 
+/// A scene built in code through the twin and the shipped monitor (default configuration): its
+/// trace and the monitor's accuracy and flags against it.
+pub fn monitor_on_scene(scene: &noback_twin::scene::Scene) -> Result<(Trace, Accuracy), String> {
+    let trace = scene_trace(scene)?;
+    let acc = compare(&trace, &run_monitor(&trace, Config::default())?);
+    Ok((trace, acc))
+}
+
 /// Runs the monitor over every row of a trace.
 pub fn run_monitor(trace: &Trace, config: Config) -> Result<Vec<Estimate>, String> {
     let mut monitor = Monitor::new(config).map_err(|e| format!("monitor config: {e:?}"))?;

@@ -12,8 +12,7 @@
 //! chatter at a heavy load and low speed, the start-up run-away at a light load and high speed,
 //! and the gentle engagement cycle at light loads.
 
-use host_tests::accuracy::{compare, run_monitor, scene_trace};
-use noback::monitor::Config;
+use host_tests::accuracy::monitor_on_scene;
 use noback_twin::reading::Reading;
 use noback_twin::scene::{Scene, SceneKind};
 
@@ -21,11 +20,7 @@ fn flags_of_continuous_closing(load_nm: f64, speed_rad_s: f64) -> Vec<(&'static 
     let mut scene = Scene::builtin(SceneKind::ContinuousClosing, Reading::Physical);
     scene.load_torque_nm = load_nm;
     scene.initial_speed_rad_s = speed_rad_s;
-    let trace = scene_trace(&scene).expect("twin");
-    let acc = compare(
-        &trace,
-        &run_monitor(&trace, Config::default()).expect("monitor"),
-    );
+    let (_, acc) = monitor_on_scene(&scene).expect("twin and monitor");
     acc.flags.iter().map(|f| (f.flag, f.t_s)).collect()
 }
 

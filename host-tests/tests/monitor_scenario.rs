@@ -451,16 +451,7 @@ fn current_reading_losing_gain_mid_drive_raises_sensor_fault() {
     // carries a 20 N·m load: the drive torque seems to fall by 11 N·m at once. (Overrunning,
     // the drive torque is 2–4 N·m and half of it is near the 1.25 N·m step allowance:
     // docs/monitor.md counts those misses.)
-    let (trace, at) = drive_with_a_change(-20.0, 5.0, |p, since| {
-        p.current_gain = if since >= 0.0 { 0.5 } else { 1.0 };
-    });
-    flagged_within_50_ms(
-        &trace,
-        at,
-        Scene::Driving,
-        |f| f.sensor_fault,
-        |f| f.brake_drag,
-    );
+    current_gain_lost_mid_drive_raises_sensor_fault(0.5, 0.4);
 }
 
 #[test]
@@ -470,8 +461,14 @@ fn current_reading_losing_most_of_its_gain_is_flagged_before_the_reading_can_cha
     // ≈ 22 to ≈ 4.4 N·m, where the overrunning reading (a load along the motion) looks
     // possible too. The step check keeps running while that change of reading is pending
     // (20 ms): were it to wait, the switch would re-seed its history past the step.
-    let (trace, at) = drive_with_a_change_at(-20.0, 5.0, 0.14, |p, since| {
-        p.current_gain = if since >= 0.0 { 0.2 } else { 1.0 };
+    current_gain_lost_mid_drive_raises_sensor_fault(0.2, 0.14);
+}
+
+/// The current reading keeps `gain` of its value from `at` on while the drive carries 20 N·m:
+/// `sensor_fault` within 50 ms, never `brake_drag`.
+fn current_gain_lost_mid_drive_raises_sensor_fault(gain: f64, at: f64) {
+    let (trace, at) = drive_with_a_change_at(-20.0, 5.0, at, |p, since| {
+        p.current_gain = if since >= 0.0 { gain } else { 1.0 };
     });
     flagged_within_50_ms(
         &trace,

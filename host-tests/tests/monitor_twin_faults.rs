@@ -13,9 +13,7 @@
 //! the next drive cut for holding faults, the running drive for drag), against issue 4's
 //! 50 ms.
 
-use host_tests::accuracy::{
-    compare, detection_latency_s, manifest_time, run_monitor, scene_trace, Accuracy,
-};
+use host_tests::accuracy::{detection_latency_s, manifest_time, monitor_on_scene, Accuracy};
 use noback::monitor::Config;
 use noback_twin::fault::{Fault, FaultKind};
 use noback_twin::reading::Reading;
@@ -27,12 +25,7 @@ const TARGET_S: f64 = 0.050;
 fn run(kind: SceneKind, fault: Option<Fault>) -> (Trace, Accuracy) {
     let mut scene = Scene::builtin(kind, Reading::Physical);
     scene.faults.extend(fault);
-    let trace = scene_trace(&scene).expect("twin");
-    let acc = compare(
-        &trace,
-        &run_monitor(&trace, Config::default()).expect("monitor"),
-    );
-    (trace, acc)
+    monitor_on_scene(&scene).expect("twin and monitor")
 }
 
 fn flag_time(acc: &Accuracy, flag: &str) -> Option<f64> {
@@ -198,11 +191,7 @@ fn a_slow_slip_while_holding_is_seen_on_both_encoders_before_the_output_span_cou
     let mut scene = Scene::builtin(SceneKind::Hold, Reading::Physical);
     scene.load_torque_nm = 8.4;
     scene.faults.push(fault);
-    let trace = scene_trace(&scene).expect("twin");
-    let acc = compare(
-        &trace,
-        &run_monitor(&trace, Config::default()).expect("monitor"),
-    );
+    let (trace, acc) = monitor_on_scene(&scene).expect("twin and monitor");
     let manifest = manifest_time(&fault, &trace).expect("the pack slips");
     let slip = flag_time(&acc, "brake_slip").expect("brake_slip");
     let angle = |t: f64| {

@@ -3,8 +3,7 @@
 //! off. The monitor must flag it (brake_slip or brake_weak), and must not when the pack is
 //! healthy. Traces come from the twin (physical reading).
 
-use host_tests::accuracy::{compare, run_monitor, scene_trace};
-use noback::monitor::Config;
+use host_tests::accuracy::monitor_on_scene;
 use noback_twin::fault::{Fault, FaultKind};
 use noback_twin::reading::Reading;
 use noback_twin::scene::{Scene, SceneKind};
@@ -12,11 +11,7 @@ use noback_twin::scene::{Scene, SceneKind};
 fn flags_after_power_on(fault: Option<Fault>) -> Vec<(&'static str, f64)> {
     let mut scene = Scene::builtin(SceneKind::Hold, Reading::Physical);
     scene.faults.extend(fault);
-    let trace = scene_trace(&scene).expect("twin");
-    let acc = compare(
-        &trace,
-        &run_monitor(&trace, Config::default()).expect("monitor"),
-    );
+    let (_, acc) = monitor_on_scene(&scene).expect("twin and monitor");
     acc.flags.iter().map(|f| (f.flag, f.t_s)).collect()
 }
 

@@ -412,6 +412,12 @@ pub(crate) struct Params {
     /// The same step of drive torque while overrunning, where the implied load `y(v) − v`
     /// moves by `g₁ − 1` ≈ 5.9 N·m per N·m of drive torque.
     pub step_limit_overrun: Q16,
+    /// The drive torque's own step that must come with a step of the implied load (N·m): half
+    /// the allowance (`DriveChecks::run`).
+    pub step_drive_min: Q16,
+    /// The drive torque's history follows by a shift of this many bits per run: the power of
+    /// two nearest to `step_alpha` (1/64 with the defaults, a 6.2 Hz corner at 2.5 kHz).
+    pub drive_ref_shift: u32,
     /// Gain of the implied load's recent history, run on one tick in four.
     pub step_alpha: Gain,
     /// Output counts of relative travel over [`SYNC_WINDOW_TICKS`] within the band.
@@ -492,10 +498,26 @@ fn counts(x: f64, parameter: &'static str) -> Result<i32, ConfigError> {
 /// (`Monitor::step`, "steady driving").
 pub(crate) const SYNC_WINDOW_TICKS: u32 = 16;
 
+/// The shift `k` whose gain `2^-k` is nearest to `gain` on a log scale (`gain` in (0, 1]; 0 for
+/// larger, 30 at most).
+fn nearest_shift(gain: f64) -> u32 {
+    let mut k = 0;
+    let mut x = gain;
+    while x < core::f64::consts::FRAC_1_SQRT_2 && k < 30 {
+        x *= 2.0;
+        k += 1;
+    }
+    k
+}
+
 /// A travel limit the common-slip check can measure on a wrapping counter: below a quarter of
 /// its range, so that the travel since the brake held (up to twice the limit before the check
 /// flags) stays within the half range its wrapping difference resolves.
-fn within_half_counter(limit: i32, bits: u8, parameter: &'static str) -> Result<i32, ConfigError> {
+fn within_quarter_counter(
+    limit: i32,
+    bits: u8,
+    parameter: &'static str,
+) -> Result<i32, ConfigError> {
     let quarter = 1_i64 << (u32::from(bits.clamp(2, 32)) - 2);
     if i64::from(limit) < quarter {
         Ok(limit)
@@ -750,6 +772,14 @@ impl Params {
             }
             m as u8 // 1 ≤ m < 32 (checked above)
         };
+        // Gain of the implied load's history, run on one tick in four.
+        let step_alpha = 1.0
+            - exp_neg(
+                core::f64::consts::TAU
+                    * positive(t.step_reference_hz, "thresholds.step_reference_hz")?
+                    * 4.0
+                    * h,
+            );
         Ok(Params {
             adc_bits: s.current_adc_bits,
             adc_max_code: ((1_u32 << s.current_adc_bits) - 1) as u16,
@@ -809,7 +839,7 @@ impl Params {
                 "thresholds.creep_limit_rad",
             )?,
             slip: SlipLimits {
-                out_counts: within_half_counter(
+                out_counts: within_quarter_counter(
                     counts(
                         t.slip_output_travel_rad / out_rad,
                         "thresholds.slip_output_travel_rad",
@@ -817,7 +847,7 @@ impl Params {
                     s.output_encoder_bits,
                     "thresholds.slip_output_travel_rad",
                 )?,
-                motor_counts: within_half_counter(
+                motor_counts: within_quarter_counter(
                     counts(
                         t.slip_input_travel_rad / in_rad,
                         "thresholds.slip_input_travel_rad",
@@ -894,15 +924,9 @@ impl Params {
                 "thresholds.sync_speed_band_rad_s",
             )?,
             motor_to_out: scale(in_rad / out_rad, "sensors.motor_encoder_counts_per_rev")?,
-            step_alpha: gain(
-                1.0 - exp_neg(
-                    core::f64::consts::TAU
-                        * positive(t.step_reference_hz, "thresholds.step_reference_hz")?
-                        * 4.0
-                        * h,
-                ),
-                "thresholds.step_reference_hz",
-            )?,
+            step_drive_min: q16(t.step_allowance_nm / 2.0, "thresholds.step_allowance_nm")?,
+            drive_ref_shift: nearest_shift(step_alpha),
+            step_alpha: gain(step_alpha, "thresholds.step_reference_hz")?,
             step_limit_overrun: q16(
                 t.step_allowance_nm * (2.0 * a_k / (a_k - 1.0) - 1.0),
                 "thresholds.step_allowance_nm",

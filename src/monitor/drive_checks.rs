@@ -77,8 +77,8 @@ impl DriveChecks {
         // (`M = y(v) − v` grows with `v`, by `g₁ − 1` per N·m: the limit is scaled so that
         // both readings allow the same step of drive torque). The history starts once the drive
         // has run steadily (the output with the input shaft) for the observer's settling time:
-        // the caller runs the checks only then and disarms them otherwise. After a change of reading it is seeded
-        // afresh once the new phase has settled (`engage_settle_s`, 20 ms, when the caller runs
+        // the caller runs the checks only then and disarms them otherwise. After a change of
+        // reading it is seeded afresh once the new phase has settled (`engage_settle_s`, 20 ms, when the caller runs
         // the checks again): the observer needs no longer, since the monitor hands the modelled
         // pack torque's step to it bumplessly.
         let along = signed(t.s, t.net.saturating_add(signed(t.s, t.pack)));
@@ -99,10 +99,9 @@ impl DriveChecks {
             // least half the allowance (a pure current step moves the implied load by the
             // full step, or `g₁ − 1` times it while overrunning).
             let drive_step = t.drive.saturating_sub(self.drive_ref);
-            let half = Q16::from_bits(p.step_limit.to_bits() >> 1);
             let (harder, lighter) = (
-                harder && drive_step > half,
-                lighter && drive_step < half.saturating_neg(),
+                harder && drive_step > p.step_drive_min,
+                lighter && drive_step < p.step_drive_min.saturating_neg(),
             );
             self.step_up_ticks = if harder && !t.pending {
                 self.step_up_ticks.saturating_add(counted)
@@ -122,11 +121,14 @@ impl DriveChecks {
             }
             if !t.pending {
                 self.step_ref = lowpass(self.step_ref, along, p.step_alpha);
-                // A shift for the gain (1/64 per run at 2.5 kHz: a 6.2 Hz corner, near the
-                // implied load's 5 Hz): the direction of a step needs no more, and it is
+                // A shift for the gain (the power of two nearest the implied load's: 1/64, a
+                // 6.2 Hz corner against 5 Hz): the direction of a step needs no more, and it is
                 // cheaper than the multiply on the drive checks' tick, the drive's worst.
                 self.drive_ref = self.drive_ref.saturating_add(Q16::from_bits(
-                    (t.drive.saturating_sub(self.drive_ref)).to_bits() >> 6,
+                    t.drive
+                        .saturating_sub(self.drive_ref)
+                        .to_bits()
+                        .wrapping_shr(p.drive_ref_shift), // ≤ 30: exact
                 ));
             }
         } else {
