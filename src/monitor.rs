@@ -401,7 +401,7 @@ impl Monitor {
     pub fn reset_flags(&mut self) {
         self.flags = Flags::default();
         self.weak_ticks = 0;
-        self.drive_checks.disarm();
+        self.drive_checks.reset();
         self.envelope = BrakingEnvelope::default();
         // Creep is measured afresh from here (the span, not its validity: a reset while
         // holding keeps the slip check armed).
@@ -661,7 +661,9 @@ impl Monitor {
             // Debounce: after the first settled decision of a drive, the other reading must
             // hold for the engage settling time before the scene switches, so that a transient
             // (crossing the lost motion) or noise at the envelope's edge cannot toggle the scene
-            // and restart the load learning.
+            // and restart the load learning. Nor while the step check is counting towards a
+            // verdict: a drag or a lost current gain can itself make the reading held
+            // impossible, and the change would re-seed the check past the step.
             if settled && !self.reading_decided {
                 self.reading_decided = true;
                 self.overrunning = wanted;
@@ -670,7 +672,9 @@ impl Monitor {
                 self.reading_ticks = 0;
             } else {
                 self.reading_ticks = self.reading_ticks.saturating_add(n);
-                if self.reading_ticks >= p.engage_settle_ticks {
+                if self.reading_ticks >= p.engage_settle_ticks
+                    && !self.drive_checks.counting_step(p)
+                {
                     self.overrunning = wanted;
                     self.reading_ticks = 0;
                 }

@@ -56,6 +56,10 @@ pub struct Outcome {
     pub latency_s: Option<f64>,
     /// Whether the fault manifested within the scene.
     pub manifested: bool,
+    /// The fault's onset fell in the monitor's settling time after power-on (the twin's scenes
+    /// start with the monitor's power-on, mid-drive): it met a monitor with no healthy
+    /// reference yet (reported apart, counted in the rate like any other run).
+    pub onset_before_settled: bool,
     /// Flags raised before the fault's onset (all flags in a nominal run).
     pub false_flags: usize,
     /// The twin failed to run this draw (reported, never silently dropped).
@@ -177,6 +181,7 @@ pub fn evaluate(d: &Draw) -> Outcome {
         fault: fault.map(|f| f.kind),
         latency_s: None,
         manifested: false,
+        onset_before_settled: false,
         false_flags: 0,
         error: Some(e),
     };
@@ -196,6 +201,10 @@ pub fn evaluate(d: &Draw) -> Outcome {
         fault: fault.map(|f| f.kind),
         latency_s: fault.and_then(|f| detection_latency_s(&f, &trace, &acc)),
         manifested: fault.is_some_and(|f| manifest_time(&f, &trace).is_some()),
+        onset_before_settled: fault.is_some_and(|f| {
+            let start = trace.rows.first().map_or(0.0, |r| r.t_s);
+            f.at_s - start < Config::default().thresholds.settle_time_s
+        }),
         false_flags: acc.flags.iter().filter(|f| f.t_s < onset).count(),
         error: None,
     }

@@ -28,6 +28,21 @@ fn run(kind: SceneKind, fault: Option<Fault>) -> (Trace, Accuracy) {
     monitor_on_scene(&scene).expect("twin and monitor")
 }
 
+/// The raised flags as (name, time) pairs, for the tests' printouts.
+fn flags_of(acc: &Accuracy) -> Vec<(&'static str, f64)> {
+    acc.flags.iter().map(|f| (f.flag, f.t_s)).collect()
+}
+
+/// Runs `scene` with `fault` and returns the fault's detection latency (printed with `label`
+/// and the flags) and the flags' names.
+fn detect(mut scene: Scene, fault: Fault, label: &str) -> (Option<f64>, Vec<&'static str>) {
+    scene.faults.push(fault);
+    let (trace, acc) = monitor_on_scene(&scene).expect("twin and monitor");
+    let latency = detection_latency_s(&fault, &trace, &acc);
+    println!("{label}: latency {latency:?}, flags {:?}", flags_of(&acc));
+    (latency, acc.flags.iter().map(|f| f.flag).collect())
+}
+
 fn flag_time(acc: &Accuracy, flag: &str) -> Option<f64> {
     acc.flags.iter().find(|f| f.flag == flag).map(|f| f.t_s)
 }
@@ -60,7 +75,7 @@ fn check_pack_that_cannot_hold(kind: SceneKind) {
     let latency = detection_latency_s(&fault, &trace, &acc);
     println!(
         "{kind:?} friction_loss 0.9: cut {cut:.4} s, brake_weak {weak:?}, latency {latency:?}, flags {:?}",
-        acc.flags.iter().map(|f| (f.flag, f.t_s)).collect::<Vec<_>>()
+        flags_of(&acc)
     );
     // The output really runs away (the fault is real) …
     assert!(
@@ -130,7 +145,7 @@ fn pack_losing_grip_while_holding_raises_brake_slip() {
     let slip = flag_time(&acc, "brake_slip").expect("brake_slip");
     println!(
         "hold, friction_loss 0.9 at 0.3 s: moving at {moved:.4} s, brake_slip at {slip:.4} s, flags {:?}",
-        acc.flags.iter().map(|f| (f.flag, f.t_s)).collect::<Vec<_>>()
+        flags_of(&acc)
     );
     assert!(
         slip > moved && slip - moved <= TARGET_S,
@@ -164,10 +179,7 @@ fn dragging_pack_while_driving_raises_brake_drag() {
     let latency = detection_latency_s(&fault, &trace, &acc);
     println!(
         "drive, drag 1.0 at 0.3 s: brake_drag at {drag:.4} s, latency {latency:?}, flags {:?}",
-        acc.flags
-            .iter()
-            .map(|f| (f.flag, f.t_s))
-            .collect::<Vec<_>>()
+        flags_of(&acc)
     );
     assert!(latency.is_some_and(|l| l <= TARGET_S), "{latency:?}");
     assert!(
@@ -204,7 +216,7 @@ fn a_slow_slip_while_holding_is_seen_on_both_encoders_before_the_output_span_cou
     let travel = (angle(slip) - angle(fault.at_s)).abs();
     println!(
         "hold 8.4 N·m, friction_loss 0.9: slipping from {manifest:.4} s, brake_slip at {slip:.4} s after {travel:.3} rad, flags {:?}",
-        acc.flags.iter().map(|f| (f.flag, f.t_s)).collect::<Vec<_>>()
+        flags_of(&acc)
     );
     assert!(slip - manifest <= TARGET_S, "{slip} vs {manifest}");
     let creep_limit = Config::default().thresholds.creep_limit_rad;
@@ -249,7 +261,7 @@ fn a_pack_that_lets_the_output_speed_up_after_the_cut_is_flagged_within_30_ms() 
         cut.t_s,
         cut.output_speed_rad_s.abs(),
         speed_at(weak),
-        acc.flags.iter().map(|f| (f.flag, f.t_s)).collect::<Vec<_>>()
+        flags_of(&acc)
     );
     assert!(
         speed_at(weak) > cut.output_speed_rad_s.abs(),
@@ -265,4 +277,69 @@ fn a_pack_that_lets_the_output_speed_up_after_the_cut_is_flagged_within_30_ms() 
         "{:?}",
         acc.flags
     );
+}
+
+/// A current reading that loses gain while the door closes under its load (overrunning, the
+/// pack slipping at the drive's equilibrium) is a `sensor_fault` within 50 ms, and never a
+/// `brake_drag`: the lower reading makes the overrunning reading impossible (the pack model
+/// drops to zero) and the monitor would switch to "the drive carries the load", where the
+/// learned load no longer fits and the drag check answered — the wrong flag — 50 ms later.
+/// The change of reading now waits for the step check's verdict, and with the pack model at
+/// its floor the implied load moves by the drive torque's step alone (the plain limit).
+#[test]
+fn current_reading_losing_gain_in_continuous_closing_is_a_sensor_fault_not_a_drag() {
+    for severity in [0.5, 0.7, 0.9] {
+        let fault = Fault {
+            kind: FaultKind::CurrentOpen,
+            at_s: 1.0,
+            severity,
+        };
+        let scene = Scene::builtin(SceneKind::ContinuousClosing, Reading::Physical);
+        let label = format!("continuous closing, current_open {severity} at 1.0 s");
+        let (latency, flags) = detect(scene, fault, &label);
+        assert!(
+            latency.is_some_and(|l| l <= TARGET_S),
+            "{label}: {latency:?}"
+        );
+        assert!(
+            flags.iter().all(|f| *f == "sensor_fault"),
+            "{label}: {flags:?}"
+        );
+    }
+}
+
+/// A pack that starts to drag while the monitor reads the drive as overrunning (a light load
+/// against the motion draws the current of a heavy one along it: at power-on the monitor cannot
+/// tell them apart and takes the overrunning reading) makes the drive push harder, past any
+/// overrunning load of the envelope: the reading must change to "the drive carries the load",
+/// and the switch re-seeded the step check's history past the step — the drag went
+/// unflagged. The change of reading now waits for the step check's verdict (its harder half
+/// counts during a pending change away from overrunning; towards it, the light-load chatter
+/// of continuous closing would be read as drag).
+#[test]
+fn pack_starting_to_drag_under_the_overrunning_reading_raises_brake_drag() {
+    for (load_nm, speed_rad_s, severity) in [(6.6, 12.8, 0.7), (8.0, 10.0, 0.6), (5.0, 16.0, 0.9)] {
+        let mut scene = Scene::builtin(SceneKind::Drive, Reading::Physical);
+        scene.load_torque_nm = load_nm;
+        scene.initial_speed_rad_s = speed_rad_s;
+        let (_, healthy) = monitor_on_scene(&scene).expect("twin and monitor");
+        assert!(
+            healthy.flags.is_empty(),
+            "healthy: {:?}",
+            flags_of(&healthy)
+        );
+        let fault = Fault {
+            kind: FaultKind::Drag,
+            at_s: 0.11,
+            severity,
+        };
+        let label = format!(
+            "drive against {load_nm} N·m at {speed_rad_s} rad/s, drag {severity} at 0.11 s"
+        );
+        let (latency, _) = detect(scene, fault, &label);
+        assert!(
+            latency.is_some_and(|l| l <= TARGET_S),
+            "{label}: {latency:?}"
+        );
+    }
 }

@@ -30,6 +30,10 @@ pub(crate) struct DriveChecks {
     step_up_ticks: u32,
     /// Ticks it has seemed to work less (current reading low).
     step_down_ticks: u32,
+    /// The step check has judged the current reading to have lost gain (`sensor_fault`):
+    /// `brake_drag` is no longer raised from it until the flags are reset (a drag read from a
+    /// reading known to be wrong would send maintenance to the brake). Kept across `disarm`.
+    current_suspect: bool,
 }
 
 /// What the step knows of this tick.
@@ -48,18 +52,39 @@ pub(crate) struct DriveTick {
     pub carrying: bool,
     /// The load learned at the start of this drive, if any: the drag check's reference.
     pub load_ref: Option<Q16>,
-    /// A change of reading is pending: only a current reading that lost its gain is looked
-    /// for (against the history as it stood), the rest waits for the reading to settle.
+    /// A change of reading is pending: the step check runs against the history as it stood
+    /// (its harder half only when the change is away from overrunning), the history is not
+    /// updated and the drag check waits for the reading to settle.
     pub pending: bool,
     /// Ticks since the previous step.
     pub ticks: u32,
 }
 
 impl DriveChecks {
-    /// Forgets the history and the persistence counts (drive off, output still, or a reset).
+    /// Forgets the history and the persistence counts (drive off, output still, a change of
+    /// reading), not the verdict on the current reading.
     #[inline]
     pub fn disarm(&mut self) {
+        *self = DriveChecks {
+            current_suspect: self.current_suspect,
+            ..DriveChecks::default()
+        };
+    }
+
+    /// Forgets everything, the verdict on the current reading too (`Monitor::reset_flags`).
+    #[inline]
+    pub fn reset(&mut self) {
         *self = DriveChecks::default();
+    }
+
+    /// The step check is counting a step of the drive's work (either way) and has not yet
+    /// reached its verdict: a pending change of reading waits for it (the change would disarm
+    /// the check and re-seed its history past the step; both faults it looks for can make the
+    /// reading held impossible). At most the persistence time more.
+    #[inline]
+    pub fn counting_step(&self, p: &Params) -> bool {
+        (self.step_down_ticks > 0 && self.step_down_ticks < p.persistence_ticks)
+            || (self.step_up_ticks > 0 && self.step_up_ticks < p.persistence_ticks)
     }
 
     /// One run (one tick in four, `t.ticks` ticks since the last step, counted four times).
@@ -86,7 +111,15 @@ impl DriveChecks {
             let dev = along.saturating_sub(self.step_ref);
             let (harder, lighter) = if t.engaged {
                 let limit = p.step_limit_overrun;
-                (dev > limit, dev < limit.saturating_neg())
+                // With the pack model at its floor (`y(v)` clamped at zero: the reading says the
+                // ramps let go) the implied load moves by the drive torque's step alone, not
+                // `g₁ − 1` times it: the plain limit.
+                let lighter_limit = if t.pack == Q16::ZERO {
+                    p.step_limit
+                } else {
+                    limit
+                };
+                (dev > limit, dev < lighter_limit.saturating_neg())
             } else {
                 (dev < p.step_limit.saturating_neg(), dev > p.step_limit)
             };
@@ -103,7 +136,11 @@ impl DriveChecks {
                 harder && drive_step > p.step_drive_min,
                 lighter && drive_step < p.step_drive_min.saturating_neg(),
             );
-            self.step_up_ticks = if harder && !t.pending {
+            // The harder half waits out a pending change towards overrunning (the light-load
+            // chatter of continuous closing pulses the drive torque by 9 N·m and makes the
+            // overrunning reading possible on each pulse), not one away from it (a drag under
+            // the overrunning reading pushes its load past the envelope).
+            self.step_up_ticks = if harder && (!t.pending || t.engaged) {
                 self.step_up_ticks.saturating_add(counted)
             } else {
                 0
@@ -113,11 +150,12 @@ impl DriveChecks {
             } else {
                 0
             };
-            if self.step_up_ticks >= p.persistence_ticks {
+            if self.step_up_ticks >= p.persistence_ticks && !self.current_suspect {
                 flags.brake_drag = true;
             }
             if self.step_down_ticks >= p.persistence_ticks {
                 flags.sensor_fault = true;
+                self.current_suspect = true;
             }
             if !t.pending {
                 self.step_ref = lowpass(self.step_ref, along, p.step_alpha);
@@ -149,7 +187,7 @@ impl DriveChecks {
             } else {
                 0
             };
-            if self.drag_ticks >= p.persistence_ticks {
+            if self.drag_ticks >= p.persistence_ticks && !self.current_suspect {
                 flags.brake_drag = true;
             }
         } else {
