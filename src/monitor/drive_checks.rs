@@ -195,3 +195,127 @@ impl DriveChecks {
         }
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::monitor::Config;
+
+    fn params() -> Params {
+        Params::from_config(&Config::default()).expect("default configuration")
+    }
+
+    /// A steady drive carrying the load (the drive pushing `drive` N·m along the motion against
+    /// a load the observer sees as the net torque `−drive + drag`), one run per call.
+    fn carrying(drive: f64, pending: bool) -> DriveTick {
+        let p = params();
+        let drive = Q16::from_num(drive);
+        DriveTick {
+            s: 1,
+            net: drive.saturating_neg().saturating_add(p.drive_drag),
+            drive,
+            pack: p.drive_drag,
+            engaged: false,
+            carrying: true,
+            load_ref: None,
+            pending,
+            ticks: 1,
+        }
+    }
+
+    /// Overrunning at a steady speed (`J·ω̇ = 0`, net `−u`): the pack at the equilibrium
+    /// `y(u)`, the implied load along the motion `y(u) − u`.
+    fn overrunning(drive: f64, pending: bool) -> DriveTick {
+        let p = params();
+        let drive_q = Q16::from_num(drive);
+        DriveTick {
+            net: drive_q.saturating_neg(),
+            pack: Q16::from_bits(p.overrun_gain.apply(drive_q.to_bits()))
+                .saturating_sub(p.overrun_offset)
+                .max(Q16::ZERO),
+            engaged: true,
+            carrying: false,
+            ..carrying(drive, pending)
+        }
+    }
+
+    /// Runs the checks `runs` times (one tick in four each) and returns the flags.
+    fn run(c: &mut DriveChecks, t: &DriveTick, runs: u32) -> Flags {
+        let p = params();
+        let mut flags = Flags::default();
+        for _ in 0..runs {
+            c.run(&mut flags, &p, t);
+        }
+        flags
+    }
+
+    #[test]
+    fn a_drive_that_works_harder_is_a_drag_and_one_that_works_less_a_sensor_fault() {
+        let mut c = DriveChecks::default();
+        assert_eq!(run(&mut c, &carrying(20.0, false), 100), Flags::default());
+        // 10 ms persistence at 10 kHz, one run in four: 25 runs.
+        assert!(run(&mut c, &carrying(25.0, false), 26).brake_drag);
+        let mut c = DriveChecks::default();
+        run(&mut c, &carrying(20.0, false), 100);
+        let f = run(&mut c, &carrying(15.0, false), 26);
+        assert!(f.sensor_fault && !f.brake_drag, "{f:?}");
+    }
+
+    #[test]
+    fn a_change_of_reading_waits_while_a_step_is_counted_and_not_longer() {
+        let p = params();
+        let mut c = DriveChecks::default();
+        run(&mut c, &carrying(20.0, false), 100);
+        assert!(!c.counting_step(&p));
+        run(&mut c, &carrying(15.0, true), 5);
+        assert!(
+            c.counting_step(&p),
+            "a lost gain is counted during a pending change"
+        );
+        run(&mut c, &carrying(15.0, true), 30);
+        assert!(
+            !c.counting_step(&p),
+            "the verdict is in: the change may go ahead"
+        );
+    }
+
+    #[test]
+    fn the_harder_half_waits_out_a_change_towards_overrunning_only() {
+        let mut c = DriveChecks::default();
+        run(&mut c, &carrying(20.0, false), 100);
+        // Pending while the drive carries the load (a change towards overrunning): no count.
+        assert!(!run(&mut c, &carrying(25.0, true), 40).brake_drag);
+        // Pending while overrunning (a change away from it): counted.
+        let mut c = DriveChecks::default();
+        run(&mut c, &overrunning(5.0, false), 100);
+        assert!(run(&mut c, &overrunning(8.0, true), 26).brake_drag);
+    }
+
+    #[test]
+    fn after_a_lost_gain_no_drag_is_read_from_the_current_until_the_flags_are_reset() {
+        let mut c = DriveChecks::default();
+        run(&mut c, &carrying(20.0, false), 100);
+        assert!(run(&mut c, &carrying(15.0, false), 26).sensor_fault);
+        c.disarm(); // a drive edge, a change of reading: the verdict stays
+        run(&mut c, &carrying(15.0, false), 100);
+        assert!(!run(&mut c, &carrying(22.0, false), 40).brake_drag);
+        c.reset(); // `reset_flags`
+        run(&mut c, &carrying(15.0, false), 100);
+        assert!(run(&mut c, &carrying(22.0, false), 40).brake_drag);
+    }
+
+    #[test]
+    fn a_lost_gain_that_drops_the_overrunning_pack_model_to_its_floor_is_a_sensor_fault() {
+        let p = params();
+        let (before, after) = (overrunning(3.0, false), overrunning(0.5, false));
+        assert!(before.pack > Q16::ZERO && after.pack == Q16::ZERO);
+        // The implied load falls by less than the overrunning limit (`g₁ − 1` allowances) but
+        // by more than the plain one: only the plain limit at the floor sees the step.
+        let fall = (before.net + before.pack) - (after.net + after.pack);
+        assert!(fall < p.step_limit_overrun && fall > p.step_limit, "{fall}");
+        let mut c = DriveChecks::default();
+        run(&mut c, &before, 100);
+        let f = run(&mut c, &after, 26);
+        assert!(f.sensor_fault && !f.brake_drag, "{f:?}");
+    }
+}
