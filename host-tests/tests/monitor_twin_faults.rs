@@ -343,3 +343,31 @@ fn pack_starting_to_drag_under_the_overrunning_reading_raises_brake_drag() {
         );
     }
 }
+
+/// A worn pack (1 mm more clearance) that opens while the door is held lets the output go with
+/// the pack *open*, not slipping: the twin's brake state stays 0 and the output runs away under
+/// the load. That is the brake failing to hold (it counted as never manifesting while only a
+/// slipping pack did) and the monitor answers within 50 ms.
+#[test]
+fn worn_pack_that_opens_while_holding_manifests_and_raises_brake_slip() {
+    let fault = Fault {
+        kind: FaultKind::PackWear,
+        at_s: 0.2,
+        severity: 0.8,
+    };
+    let (trace, acc) = run(SceneKind::Hold, Some(fault));
+    let manifest = manifest_time(&fault, &trace).expect("the brake lets go");
+    let open = trace
+        .rows
+        .iter()
+        .filter(|r| r.t_s >= manifest && r.t_s < manifest + 0.02)
+        .all(|r| r.brake_state == 0);
+    assert!(open, "the pack is open, not slipping, when it lets go");
+    let latency = detection_latency_s(&fault, &trace, &acc);
+    println!(
+        "hold, pack_wear 0.8 at 0.2 s: lets go at {manifest:.4} s, latency {latency:?}, flags {:?}",
+        flags_of(&acc)
+    );
+    assert!(latency.is_some_and(|l| l <= TARGET_S), "{latency:?}");
+    assert!(flag_time(&acc, "brake_slip").is_some());
+}

@@ -4,7 +4,9 @@
 
 use crate::replay::twin_trace;
 use crate::shell::workspace_root;
-use host_tests::accuracy::{compare, run_monitor, COMPARE_WINDOW_S};
+use host_tests::accuracy::{
+    compare, run_monitor, COMPARE_WINDOW_S, FAILED_HOLD_SLIP_S, HELD_RATTLE_RAD,
+};
 use host_tests::mc::{draw, run_all, Outcome, DETECTION_WINDOW_S, FAULT_KINDS};
 use noback::monitor::Config;
 use serde_json::json;
@@ -261,8 +263,9 @@ fn doc(a: &Args, r: &serde_json::Value) -> String {
          0.5–1 (each kind's meaning is in `model.md`).\n\
          - *Manifesting* (`host_tests::accuracy::manifest_time`, from the twin's truth): a \
          holding fault (friction_loss, spring_broken, pack_wear, ramp_jam) when, with the drive \
-         off, the pack keeps slipping for 20 ms (a healthy pack locks within 2–10 ms): the brake \
-         is failing to hold; drag and current_open when the drive next runs; encoder_jump at its \
+         off, the pack does not hold — slips, or stays open — for {:.0} ms (a healthy pack locks \
+         within 2–11 ms) and the output turns more than {:.2} rad meanwhile (beyond the rattle \
+         of a held output in its lost motion): the brake is failing to hold; drag and current_open when the drive next runs; encoder_jump at its \
          onset; encoder_stuck once the shaft has truly turned two counts. A fault that never \
          manifests in its scene (for instance a weakened pack that still self-locks: dormant, \
          the case periodic functional tests exist for) is counted in the runs but not in the \
@@ -286,6 +289,8 @@ fn doc(a: &Args, r: &serde_json::Value) -> String {
         a.runs,
         a.fault_runs,
         a.seed,
+        FAILED_HOLD_SLIP_S * 1e3,
+        HELD_RATTLE_RAD,
         DETECTION_WINDOW_S * 1e3,
         DETECTION_TARGET * 100.0,
         Config::default().thresholds.settle_time_s * 1e3,
