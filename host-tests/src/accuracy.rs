@@ -130,6 +130,11 @@ pub struct Accuracy {
 }
 
 impl Accuracy {
+    /// The raised flags as (name, time in s) pairs, in the order they rose.
+    pub fn flag_times(&self) -> Vec<(&'static str, f64)> {
+        self.flags.iter().map(|f| (f.flag, f.t_s)).collect()
+    }
+
     /// Holding-torque error in % of the twin's.
     pub fn holding_torque_err_pct(&self) -> Option<f64> {
         self.holding_torque_nm

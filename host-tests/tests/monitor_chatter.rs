@@ -21,7 +21,7 @@ fn flags_of_continuous_closing(load_nm: f64, speed_rad_s: f64) -> Vec<(&'static 
     scene.load_torque_nm = load_nm;
     scene.initial_speed_rad_s = speed_rad_s;
     let (_, acc) = monitor_on_scene(&scene).expect("twin and monitor");
-    acc.flags.iter().map(|f| (f.flag, f.t_s)).collect()
+    acc.flag_times()
 }
 
 #[test]

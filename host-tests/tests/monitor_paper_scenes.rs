@@ -38,7 +38,7 @@ fn accuracy(scene: &str) -> Accuracy {
         acc.braking_torque_rmse_nm,
         acc.holding_torque_err_pct(),
         acc.lock_time_err_s(),
-        acc.flags.iter().map(|f| (f.flag, f.t_s)).collect::<Vec<_>>()
+        acc.flag_times()
     );
     acc
 }

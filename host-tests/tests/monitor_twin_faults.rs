@@ -18,7 +18,7 @@ use noback::monitor::Config;
 use noback_twin::fault::{Fault, FaultKind};
 use noback_twin::reading::Reading;
 use noback_twin::scene::{Scene, SceneKind};
-use noback_twin::trace::Trace;
+use noback_twin::trace::{Trace, TraceRow};
 
 const TARGET_S: f64 = 0.050;
 
@@ -28,19 +28,19 @@ fn run(kind: SceneKind, fault: Option<Fault>) -> (Trace, Accuracy) {
     monitor_on_scene(&scene).expect("twin and monitor")
 }
 
-/// The raised flags as (name, time) pairs, for the tests' printouts.
-fn flags_of(acc: &Accuracy) -> Vec<(&'static str, f64)> {
-    acc.flags.iter().map(|f| (f.flag, f.t_s)).collect()
-}
-
 /// Runs `scene` with `fault` and returns the fault's detection latency (printed with `label`
 /// and the flags) and the flags' names.
 fn detect(mut scene: Scene, fault: Fault, label: &str) -> (Option<f64>, Vec<&'static str>) {
     scene.faults.push(fault);
     let (trace, acc) = monitor_on_scene(&scene).expect("twin and monitor");
     let latency = detection_latency_s(&fault, &trace, &acc);
-    println!("{label}: latency {latency:?}, flags {:?}", flags_of(&acc));
+    println!("{label}: latency {latency:?}, flags {:?}", acc.flag_times());
     (latency, acc.flags.iter().map(|f| f.flag).collect())
+}
+
+/// The trace's first sample at or after `t` (s).
+fn row_at(trace: &Trace, t: f64) -> Option<&TraceRow> {
+    trace.rows.iter().find(|r| r.t_s >= t)
 }
 
 fn flag_time(acc: &Accuracy, flag: &str) -> Option<f64> {
@@ -75,7 +75,7 @@ fn check_pack_that_cannot_hold(kind: SceneKind) {
     let latency = detection_latency_s(&fault, &trace, &acc);
     println!(
         "{kind:?} friction_loss 0.9: cut {cut:.4} s, brake_weak {weak:?}, latency {latency:?}, flags {:?}",
-        flags_of(&acc)
+        acc.flag_times()
     );
     // The output really runs away (the fault is real) …
     assert!(
@@ -145,7 +145,7 @@ fn pack_losing_grip_while_holding_raises_brake_slip() {
     let slip = flag_time(&acc, "brake_slip").expect("brake_slip");
     println!(
         "hold, friction_loss 0.9 at 0.3 s: moving at {moved:.4} s, brake_slip at {slip:.4} s, flags {:?}",
-        flags_of(&acc)
+        acc.flag_times()
     );
     assert!(
         slip > moved && slip - moved <= TARGET_S,
@@ -179,7 +179,7 @@ fn dragging_pack_while_driving_raises_brake_drag() {
     let latency = detection_latency_s(&fault, &trace, &acc);
     println!(
         "drive, drag 1.0 at 0.3 s: brake_drag at {drag:.4} s, latency {latency:?}, flags {:?}",
-        flags_of(&acc)
+        acc.flag_times()
     );
     assert!(latency.is_some_and(|l| l <= TARGET_S), "{latency:?}");
     assert!(
@@ -206,17 +206,11 @@ fn a_slow_slip_while_holding_is_seen_on_both_encoders_before_the_output_span_cou
     let (trace, acc) = monitor_on_scene(&scene).expect("twin and monitor");
     let manifest = manifest_time(&fault, &trace).expect("the pack slips");
     let slip = flag_time(&acc, "brake_slip").expect("brake_slip");
-    let angle = |t: f64| {
-        trace
-            .rows
-            .iter()
-            .find(|r| r.t_s >= t)
-            .map_or(f64::NAN, |r| r.output_angle_rad)
-    };
+    let angle = |t: f64| row_at(&trace, t).map_or(f64::NAN, |r| r.output_angle_rad);
     let travel = (angle(slip) - angle(fault.at_s)).abs();
     println!(
         "hold 8.4 N·m, friction_loss 0.9: slipping from {manifest:.4} s, brake_slip at {slip:.4} s after {travel:.3} rad, flags {:?}",
-        flags_of(&acc)
+        acc.flag_times()
     );
     assert!(slip - manifest <= TARGET_S, "{slip} vs {manifest}");
     let creep_limit = Config::default().thresholds.creep_limit_rad;
@@ -249,19 +243,13 @@ fn a_pack_that_lets_the_output_speed_up_after_the_cut_is_flagged_within_30_ms() 
         .find(|r| !r.drive_on)
         .expect("the scene cuts the drive");
     let weak = flag_time(&acc, "brake_weak").expect("brake_weak");
-    let speed_at = |t: f64| {
-        trace
-            .rows
-            .iter()
-            .find(|r| r.t_s >= t)
-            .map_or(f64::NAN, |r| r.output_speed_rad_s.abs())
-    };
+    let speed_at = |t: f64| row_at(&trace, t).map_or(f64::NAN, |r| r.output_speed_rad_s.abs());
     println!(
         "forward_load, friction_loss 0.7: cut {:.4} s at {:.2} rad/s, brake_weak {weak:.4} s at {:.2} rad/s, flags {:?}",
         cut.t_s,
         cut.output_speed_rad_s.abs(),
         speed_at(weak),
-        flags_of(&acc)
+        acc.flag_times()
     );
     assert!(
         speed_at(weak) > cut.output_speed_rad_s.abs(),
@@ -326,7 +314,7 @@ fn pack_starting_to_drag_under_the_overrunning_reading_raises_brake_drag() {
         assert!(
             healthy.flags.is_empty(),
             "healthy: {:?}",
-            flags_of(&healthy)
+            healthy.flag_times()
         );
         let fault = Fault {
             kind: FaultKind::Drag,
@@ -366,7 +354,7 @@ fn worn_pack_that_opens_while_holding_manifests_and_raises_brake_slip() {
     let latency = detection_latency_s(&fault, &trace, &acc);
     println!(
         "hold, pack_wear 0.8 at 0.2 s: lets go at {manifest:.4} s, latency {latency:?}, flags {:?}",
-        flags_of(&acc)
+        acc.flag_times()
     );
     assert!(latency.is_some_and(|l| l <= TARGET_S), "{latency:?}");
     assert!(flag_time(&acc, "brake_slip").is_some());

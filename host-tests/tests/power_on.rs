@@ -12,7 +12,7 @@ fn flags_after_power_on(fault: Option<Fault>) -> Vec<(&'static str, f64)> {
     let mut scene = Scene::builtin(SceneKind::Hold, Reading::Physical);
     scene.faults.extend(fault);
     let (_, acc) = monitor_on_scene(&scene).expect("twin and monitor");
-    acc.flags.iter().map(|f| (f.flag, f.t_s)).collect()
+    acc.flag_times()
 }
 
 #[test]

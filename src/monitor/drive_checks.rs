@@ -86,8 +86,8 @@ impl DriveChecks {
     /// reading held impossible). At most the persistence time more.
     #[inline]
     pub fn counting_step(&self, p: &Params) -> bool {
-        (self.step_down_ticks > 0 && self.step_down_ticks < p.persistence_ticks)
-            || (self.step_up_ticks > 0 && self.step_up_ticks < p.persistence_ticks)
+        let counting = 1..p.persistence_ticks;
+        counting.contains(&self.step_down_ticks) || counting.contains(&self.step_up_ticks)
     }
 
     /// One run (one tick in four, `t.ticks` ticks since the last step, counted four times).
@@ -106,9 +106,9 @@ impl DriveChecks {
         // both readings allow the same step of drive torque). The history starts once the drive
         // has run steadily (the output with the input shaft) for the observer's settling time:
         // the caller runs the checks only then and disarms them otherwise. After a change of
-        // reading it is seeded afresh once the new phase has settled (`engage_settle_s`, 20 ms, when the caller runs
-        // the checks again): the observer needs no longer, since the monitor hands the modelled
-        // pack torque's step to it bumplessly.
+        // reading it is seeded afresh once the new phase has settled (`engage_settle_s`, 20 ms,
+        // when the caller runs the checks again): the observer needs no longer, since the
+        // monitor hands the modelled pack torque's step to it bumplessly.
         let along = signed(t.s, t.net.saturating_add(signed(t.s, t.pack)));
         if self.step_ref_valid {
             let dev = along.saturating_sub(self.step_ref);

@@ -93,7 +93,7 @@ pub fn main(args: &[String]) -> Result<i32, String> {
             .iter()
             .filter(|o| o.fault == Some(kind) && o.error.is_none())
             .collect();
-        let manifested: Vec<&&Outcome> = runs.iter().filter(|o| o.manifested).collect();
+        let manifested: Vec<&Outcome> = runs.iter().copied().filter(|o| o.manifested).collect();
         let mut latencies: Vec<f64> = manifested
             .iter()
             .filter_map(|o| o.latency_s)
@@ -102,27 +102,24 @@ pub fn main(args: &[String]) -> Result<i32, String> {
         latencies.sort_by(f64::total_cmp);
         let detected = latencies.len();
         // No manifested run leaves the target unproven: it counts as not met, shown as "—".
-        let rate = (!manifested.is_empty()).then(|| detected as f64 / manifested.len() as f64);
+        let rate = detection_rate(detected, manifested.len());
         all_ok &= rate.is_some_and(|r| r >= DETECTION_TARGET);
         // The same among the runs whose onset came after the monitor had settled (shown apart;
         // the target is on the whole column).
-        let settled: Vec<&&&Outcome> = manifested
-            .iter()
-            .filter(|o| !o.onset_before_settled)
-            .collect();
+        let settled = manifested.iter().filter(|o| !o.onset_before_settled);
         let detected_settled = settled
-            .iter()
+            .clone()
             .filter(|o| o.latency_s.is_some_and(|l| l <= DETECTION_WINDOW_S))
             .count();
-        let rate_settled =
-            (!settled.is_empty()).then(|| detected_settled as f64 / settled.len() as f64);
+        let manifested_settled = settled.count();
+        let rate_settled = detection_rate(detected_settled, manifested_settled);
         rows.push(json!({
             "kind": format!("{kind:?}"),
             "runs": runs.len(),
             "manifested": manifested.len(),
             "detected_within_window": detected,
             "detection_rate": rate,
-            "manifested_after_settling": settled.len(),
+            "manifested_after_settling": manifested_settled,
             "detected_after_settling": detected_settled,
             "detection_rate_after_settling": rate_settled,
             "latency_median_s": latencies.get(detected / 2),
@@ -174,6 +171,17 @@ pub fn main(args: &[String]) -> Result<i32, String> {
     Ok(0)
 }
 
+/// Detected over manifested; `None` when nothing manifested.
+fn detection_rate(detected: usize, manifested: usize) -> Option<f64> {
+    (manifested > 0).then(|| detected as f64 / manifested as f64)
+}
+
+/// A rate in the table: "97.5 %", or "—" when there is none.
+fn fmt_rate(v: &serde_json::Value) -> String {
+    v.as_f64()
+        .map_or("—".into(), |r| format!("{:.1} %", r * 100.0))
+}
+
 fn fmt_opt(v: &serde_json::Value, scale: f64, digits: usize) -> String {
     v.as_f64()
         .map_or("—".into(), |x| format!("{:.*}", digits, x * scale))
@@ -198,17 +206,13 @@ fn table(r: &serde_json::Value) -> String {
             row["runs"],
             row["manifested"],
             row["detected_within_window"],
-            row["detection_rate"]
-                .as_f64()
-                .map_or("—".into(), |r| format!("{:.1} %", r * 100.0)),
+            fmt_rate(&row["detection_rate"]),
             fmt_opt(&row["latency_median_s"], 1e3, 1),
             fmt_opt(&row["latency_max_s"], 1e3, 1),
             row["false_alarms_before_onset"],
             row["detected_after_settling"],
             row["manifested_after_settling"],
-            row["detection_rate_after_settling"]
-                .as_f64()
-                .map_or("—".into(), |r| format!("{:.1} %", r * 100.0)),
+            fmt_rate(&row["detection_rate_after_settling"]),
         );
     }
     let _ = writeln!(s, "\n| paper scene | pressing-force RMS (% of peak) | braking-torque RMS (N·m) | holding torque error (%) | lock time error (ms) | flags |");
@@ -256,8 +260,8 @@ fn doc(a: &Args, r: &serde_json::Value) -> String {
          - Nominal draws: reverse_load, forward_load, hold, drive or continuous_closing (the \
          door closing under its load, the drive on throughout: overrunning, often with the \
          pack's engagement chatter); load 5–30 N·m; speed 5–20 rad/s (the input's, in \
-         continuous_closing); drive cut at 0.1–0.3 s; every Table 2 parameter scaled by its own factor in \
-         [0.9, 1.1]; current noise 0–0.1 A; the load in either direction (a mirrored run negates \
+         continuous_closing); drive cut at 0.1–0.3 s; every Table 2 parameter scaled by its \
+         own factor in [0.9, 1.1]; current noise 0–0.1 A; the load in either direction (a mirrored run negates \
          every sensor reading). Any flag in a nominal run is a false alarm.\n\
          - Fault draws: the same plus one fault, onset uniform over the scene, severity \
          0.5–1 (each kind's meaning is in `model.md`).\n\
@@ -265,8 +269,9 @@ fn doc(a: &Args, r: &serde_json::Value) -> String {
          holding fault (friction_loss, spring_broken, pack_wear, ramp_jam) when, with the drive \
          off, the pack does not hold — slips, or stays open — for {:.0} ms (a healthy pack locks \
          within 2–11 ms) and the output turns more than {:.2} rad meanwhile (beyond the rattle \
-         of a held output in its lost motion): the brake is failing to hold; drag and current_open when the drive next runs; encoder_jump at its \
-         onset; encoder_stuck once the shaft has truly turned two counts. A fault that never \
+         of a held output in its lost motion): the brake is failing to hold; drag and \
+         current_open when the drive next runs; encoder_jump at its onset; encoder_stuck once \
+         the shaft has truly turned two counts. A fault that never \
          manifests in its scene (for instance a weakened pack that still self-locks: dormant, \
          the case periodic functional tests exist for) is counted in the runs but not in the \
          rate.\n\
