@@ -274,25 +274,26 @@ pub fn expected_flag(kind: FaultKind) -> &'static [&'static str] {
 /// a longer one is the brake failing to hold.
 pub const FAILED_HOLD_SLIP_S: f64 = 0.020;
 
-/// How far the output must turn in such a run for the failure to show (rad): beyond the
-/// rattle in the lost motion of a held output (≤ 0.13 rad in 1000 nominal Monte Carlo draws,
-/// docs/monitor-design.md, "Common slip"), which a pack that opens for a while without letting
-/// the output go (a broken spring's longer rattle) stays inside.
+/// How far the output must turn for a failure to hold, or a frozen output reading, to show
+/// (rad): beyond the rattle in the lost motion of a held output (≤ 0.13 rad in 1000 nominal
+/// Monte Carlo draws, docs/monitor-design.md, "Common slip"). Inside it the encoders show what a
+/// held output shows: a pack that opens for a while without letting the output go (a broken
+/// spring's longer rattle), a worn pack whose output has only begun to creep, or a frozen
+/// output reading of a shaft that rattles in its lost motion (no other sensor sees the output
+/// inside its lost motion).
 pub const HELD_RATTLE_RAD: f64 = 0.13;
-
-/// Output-encoder counts the shaft must truly turn before a stuck encoder can be noticed.
-pub const STUCK_VISIBLE_COUNTS: f64 = 2.0;
 
 /// When a fault first changes what the sensors can show — before that no monitor could see it
 /// (a weakened pack that still self-locks is dormant, the case the periodic functional tests of
 /// the field exist for). From the twin's truth columns:
-/// - holding faults (friction_loss, spring_broken, pack_wear, ramp_jam): the start of the first
-///   run, at or after the onset, in which the drive is off and the pack does not hold (slips, or
-///   is open) for at least [`FAILED_HOLD_SLIP_S`] and the output turns more than
-///   [`HELD_RATTLE_RAD`] from where it was when the run began;
+/// - holding faults (friction_loss, spring_broken, pack_wear, ramp_jam): in the first run, at
+///   or after the onset, in which the drive is off and the pack does not hold (slips, or is
+///   open) for at least [`FAILED_HOLD_SLIP_S`] and the output turns more than
+///   [`HELD_RATTLE_RAD`] from where it was when the run began, the moment it passes that
+///   (before it, the output is still where a held one can be);
 /// - drag: the first sample at or after the onset with the drive running;
-/// - encoder_jump: at the onset; encoder_stuck: once the true output angle has moved
-///   [`STUCK_VISIBLE_COUNTS`] counts from its value at the onset;
+/// - encoder_jump: at the onset; encoder_stuck: once the true output angle has left its value
+///   at the onset (the frozen reading) by more than [`HELD_RATTLE_RAD`];
 /// - current_open: the first sample at or after the onset with the drive running (a current is
 ///   then expected).
 pub fn manifest_time(fault: &Fault, trace: &Trace) -> Option<f64> {
@@ -303,26 +304,29 @@ pub fn manifest_time(fault: &Fault, trace: &Trace) -> Option<f64> {
         FaultKind::EncoderJump => Some(fault.at_s),
         FaultKind::Drag | FaultKind::CurrentOpen => after().find(|r| r.drive_on).map(|r| r.t_s),
         FaultKind::EncoderStuck => {
-            let count_rad = std::f64::consts::TAU / 16_384.0;
             let angle0 = rows.get(start)?.output_angle_rad;
             after()
-                .find(|r| (r.output_angle_rad - angle0).abs() >= STUCK_VISIBLE_COUNTS * count_rad)
+                .find(|r| (r.output_angle_rad - angle0).abs() > HELD_RATTLE_RAD)
                 .map(|r| r.t_s)
         }
         FaultKind::FrictionLoss
         | FaultKind::SpringBroken
         | FaultKind::PackWear
         | FaultKind::RampJam => {
-            // (start time, output angle at the start) of the present run without holding.
-            let mut run: Option<(f64, f64)> = None;
+            // The present run without holding: its start time, the output angle then, and when
+            // the output first left the held rattle in it.
+            let mut run: Option<(f64, f64, Option<f64>)> = None;
             for r in after() {
                 // Brake states: 0 released, 1 slipping, 2 locked (docs/trace-format.md).
                 if !r.drive_on && r.brake_state != 2 {
-                    let (t0, angle0) = *run.get_or_insert((r.t_s, r.output_angle_rad));
-                    if r.t_s - t0 >= FAILED_HOLD_SLIP_S
-                        && (r.output_angle_rad - angle0).abs() > HELD_RATTLE_RAD
-                    {
-                        return Some(t0);
+                    let (t0, angle0, left) = run.get_or_insert((r.t_s, r.output_angle_rad, None));
+                    if left.is_none() && (r.output_angle_rad - *angle0).abs() > HELD_RATTLE_RAD {
+                        *left = Some(r.t_s);
+                    }
+                    if r.t_s - *t0 >= FAILED_HOLD_SLIP_S {
+                        if let Some(t) = left {
+                            return Some(*t);
+                        }
                     }
                 } else {
                     run = None;
@@ -350,4 +354,78 @@ pub fn detection_latency_s(fault: &Fault, trace: &Trace, acc: &Accuracy) -> Opti
 pub fn false_alarms(faults: &[Fault], acc: &Accuracy) -> usize {
     let first = faults.iter().map(|f| f.at_s).fold(f64::INFINITY, f64::min);
     acc.flags.iter().filter(|f| f.t_s < first).count()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use noback_twin::trace::TraceRow;
+    use std::f64::consts::TAU;
+
+    /// A 10 kHz truth trace, drive off, with the output angle and brake state given per sample.
+    fn trace(samples: impl Iterator<Item = (f64, u8)>) -> Trace {
+        Trace {
+            sample_rate_hz: 10_000.0,
+            rows: samples
+                .enumerate()
+                .map(|(i, (angle, brake_state))| TraceRow {
+                    t_s: i as f64 * 1e-4,
+                    output_angle_rad: angle,
+                    brake_state,
+                    ..TraceRow::default()
+                })
+                .collect(),
+        }
+    }
+
+    fn fault(kind: FaultKind) -> Fault {
+        Fault {
+            kind,
+            at_s: 0.01,
+            severity: 1.0,
+        }
+    }
+
+    #[test]
+    fn a_frozen_output_reading_of_a_shaft_rattling_in_its_lost_motion_never_manifests() {
+        // ±0.1 rad at 50 Hz for 0.5 s: a held output's rattle, whatever the encoder says.
+        let t = trace((0..5000).map(|i| (0.1 * (i as f64 * 1e-4 * 50.0 * TAU).sin(), 2)));
+        assert_eq!(manifest_time(&fault(FaultKind::EncoderStuck), &t), None);
+    }
+
+    #[test]
+    fn a_frozen_output_reading_manifests_when_the_shaft_leaves_the_held_rattle() {
+        // The output runs away at 5 rad/s: 0.13 rad beyond its angle at the onset (0.01 s)
+        // 26 ms later.
+        let t = trace((0..2000).map(|i| (5.0 * i as f64 * 1e-4, 0)));
+        let at = manifest_time(&fault(FaultKind::EncoderStuck), &t).expect("manifests");
+        assert!((at - 0.0361).abs() < 2e-4, "{at}");
+    }
+
+    #[test]
+    fn a_failing_hold_manifests_when_the_output_leaves_the_held_rattle() {
+        // The pack opens at 0.05 s and the output accelerates from rest at 40 rad/s²: it passes
+        // 0.13 rad after 80.6 ms, long after the 20 ms a failing hold must last.
+        let t = trace((0..3000).map(|i| {
+            let t = i as f64 * 1e-4;
+            if t < 0.05 {
+                (0.0, 2)
+            } else {
+                (20.0 * (t - 0.05) * (t - 0.05), 0)
+            }
+        }));
+        let at = manifest_time(&fault(FaultKind::PackWear), &t).expect("manifests");
+        assert!((at - 0.1306).abs() < 2e-4, "{at}");
+    }
+
+    #[test]
+    fn a_pack_that_opens_without_letting_the_output_go_never_manifests() {
+        // Open for 30 ms, the output inside the rattle, then locked again.
+        let t = trace((0..3000).map(|i| {
+            let t = i as f64 * 1e-4;
+            let open = (0.05..0.08).contains(&t);
+            (if open { 0.05 } else { 0.0 }, if open { 0 } else { 2 })
+        }));
+        assert_eq!(manifest_time(&fault(FaultKind::SpringBroken), &t), None);
+    }
 }

@@ -60,10 +60,58 @@ pub struct Outcome {
     /// start with the monitor's power-on, mid-drive): it met a monitor with no healthy
     /// reference yet (reported apart, counted in the rate like any other run).
     pub onset_before_settled: bool,
+    /// Where the fault fell, for reading the misses (`None` in a nominal run).
+    pub context: Option<Context>,
     /// Flags raised before the fault's onset (all flags in a nominal run).
     pub false_flags: usize,
     /// The twin failed to run this draw (reported, never silently dropped).
     pub error: Option<String>,
+}
+
+/// Where a fault fell in its run: the classes the misses are reported by (docs/monitor.md).
+/// The first that applies.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Context {
+    /// The onset fell in the monitor's settling time after power-on (the scenes start
+    /// mid-drive with it): no healthy reference yet.
+    Settling,
+    /// The drive was running at the onset and was cut before the drive checks' phase settling
+    /// (`thresholds.engage_settle_s`) had passed: the fault met less drive than any drive check
+    /// needs.
+    ShortDrive,
+    /// Continuous closing: the drive on throughout, overrunning, with the pack's engagement
+    /// chatter.
+    ContinuousClosing,
+    /// None of the above.
+    Other,
+}
+
+impl Context {
+    /// Every context, in the order of the report.
+    pub const ALL: [Context; 4] = [
+        Context::Settling,
+        Context::ShortDrive,
+        Context::ContinuousClosing,
+        Context::Other,
+    ];
+
+    /// The context of a fault with onset `at_s` in `trace` of a `kind` scene.
+    pub fn of(at_s: f64, trace: &Trace, kind: SceneKind) -> Context {
+        let t = &Config::default().thresholds;
+        let start = trace.rows.first().map_or(0.0, |r| r.t_s);
+        let mut after = trace.rows.iter().skip_while(|r| r.t_s < at_s);
+        let driving_at_onset = after.clone().next().is_some_and(|r| r.drive_on);
+        let cut = after.find(|r| !r.drive_on).map(|r| r.t_s);
+        if at_s - start < t.settle_time_s {
+            Context::Settling
+        } else if driving_at_onset && cut.is_some_and(|c| c - at_s < t.engage_settle_s) {
+            Context::ShortDrive
+        } else if kind == SceneKind::ContinuousClosing {
+            Context::ContinuousClosing
+        } else {
+            Context::Other
+        }
+    }
 }
 
 fn scale_all(m: &mut Mechanism, rng: &mut Rng) {
@@ -182,6 +230,7 @@ pub fn evaluate(d: &Draw) -> Outcome {
         latency_s: None,
         manifested: false,
         onset_before_settled: false,
+        context: None,
         false_flags: 0,
         error: Some(e),
     };
@@ -205,6 +254,7 @@ pub fn evaluate(d: &Draw) -> Outcome {
             let start = trace.rows.first().map_or(0.0, |r| r.t_s);
             f.at_s - start < Config::default().thresholds.settle_time_s
         }),
+        context: fault.map(|f| Context::of(f.at_s, &trace, d.scene.kind)),
         false_flags: acc.flags.iter().filter(|f| f.t_s < onset).count(),
         error: None,
     }

@@ -7,7 +7,7 @@ use crate::shell::workspace_root;
 use host_tests::accuracy::{
     compare, run_monitor, COMPARE_WINDOW_S, FAILED_HOLD_SLIP_S, HELD_RATTLE_RAD,
 };
-use host_tests::mc::{draw, run_all, Outcome, DETECTION_WINDOW_S, FAULT_KINDS};
+use host_tests::mc::{draw, run_all, Context, Outcome, DETECTION_WINDOW_S, FAULT_KINDS};
 use noback::monitor::Config;
 use serde_json::json;
 use std::fmt::Write as _;
@@ -113,6 +113,18 @@ pub fn main(args: &[String]) -> Result<i32, String> {
             .count();
         let manifested_settled = settled.count();
         let rate_settled = detection_rate(detected_settled, manifested_settled);
+        // Where the misses fell: manifested and missed runs per context.
+        let by_context: Vec<_> = Context::ALL
+            .iter()
+            .map(|c| {
+                let here = manifested.iter().filter(|o| o.context == Some(*c));
+                json!({
+                    "context": context_name(*c),
+                    "manifested": here.clone().count(),
+                    "missed": here.filter(|o| !o.latency_s.is_some_and(|l| l <= DETECTION_WINDOW_S)).count(),
+                })
+            })
+            .collect();
         rows.push(json!({
             "kind": format!("{kind:?}"),
             "runs": runs.len(),
@@ -122,6 +134,7 @@ pub fn main(args: &[String]) -> Result<i32, String> {
             "manifested_after_settling": manifested_settled,
             "detected_after_settling": detected_settled,
             "detection_rate_after_settling": rate_settled,
+            "by_context": by_context,
             "latency_median_s": latencies.get(detected / 2),
             "latency_max_s": latencies.last(),
             "false_alarms_before_onset": runs.iter().filter(|o| o.false_flags > 0).count(),
@@ -171,6 +184,16 @@ pub fn main(args: &[String]) -> Result<i32, String> {
     Ok(0)
 }
 
+/// A context's name in the report.
+fn context_name(c: Context) -> &'static str {
+    match c {
+        Context::Settling => "onset while the monitor settles",
+        Context::ShortDrive => "drive cut before the drive checks settle",
+        Context::ContinuousClosing => "continuous closing",
+        Context::Other => "elsewhere",
+    }
+}
+
 /// Detected over manifested; `None` when nothing manifested.
 fn detection_rate(detected: usize, manifested: usize) -> Option<f64> {
     (manifested > 0).then(|| detected as f64 / manifested as f64)
@@ -213,6 +236,30 @@ fn table(r: &serde_json::Value) -> String {
             row["detected_after_settling"],
             row["manifested_after_settling"],
             fmt_rate(&row["detection_rate_after_settling"]),
+        );
+    }
+    let _ = writeln!(
+        s,
+        "\nMisses by where the fault fell (missed / manifested; the first that applies):\n"
+    );
+    let _ = writeln!(
+        s,
+        "| fault kind | {} |",
+        Context::ALL.map(context_name).join(" | ")
+    );
+    let _ = writeln!(s, "|---|{}", "---|".repeat(Context::ALL.len()));
+    for row in r["fault_kinds"].as_array().into_iter().flatten() {
+        let cells: Vec<String> = row["by_context"]
+            .as_array()
+            .into_iter()
+            .flatten()
+            .map(|c| format!("{} / {}", c["missed"], c["manifested"]))
+            .collect();
+        let _ = writeln!(
+            s,
+            "| {} | {} |",
+            row["kind"].as_str().unwrap_or(""),
+            cells.join(" | ")
         );
     }
     let _ = writeln!(s, "\n| paper scene | pressing-force RMS (% of peak) | braking-torque RMS (N·m) | holding torque error (%) | lock time error (ms) | flags |");
@@ -268,10 +315,13 @@ fn doc(a: &Args, r: &serde_json::Value) -> String {
          - *Manifesting* (`host_tests::accuracy::manifest_time`, from the twin's truth): a \
          holding fault (friction_loss, spring_broken, pack_wear, ramp_jam) when, with the drive \
          off, the pack does not hold — slips, or stays open — for {:.0} ms (a healthy pack locks \
-         within 2–11 ms) and the output turns more than {:.2} rad meanwhile (beyond the rattle \
-         of a held output in its lost motion): the brake is failing to hold; drag and \
-         current_open when the drive next runs; encoder_jump at its onset; encoder_stuck once \
-         the shaft has truly turned two counts. A fault that never \
+         within 2–11 ms) and the output turns more than {rattle:.2} rad meanwhile: the brake is \
+         failing to hold, from the moment the output passes that turn (inside it, the rattle of \
+         a held output in its lost motion, the encoders show what a held output shows); drag \
+         and current_open when the drive next runs; encoder_jump at its onset; encoder_stuck \
+         once the true output has left the frozen reading by more than {rattle:.2} rad (inside \
+         it the frozen reading is what a held output rattling in its lost motion shows, and no \
+         other sensor sees the output there). A fault that never \
          manifests in its scene (for instance a weakened pack that still self-locks: dormant, \
          the case periodic functional tests exist for) is counted in the runs but not in the \
          rate.\n\
@@ -295,7 +345,6 @@ fn doc(a: &Args, r: &serde_json::Value) -> String {
         a.fault_runs,
         a.seed,
         FAILED_HOLD_SLIP_S * 1e3,
-        HELD_RATTLE_RAD,
         DETECTION_WINDOW_S * 1e3,
         DETECTION_TARGET * 100.0,
         Config::default().thresholds.settle_time_s * 1e3,
@@ -306,5 +355,6 @@ fn doc(a: &Args, r: &serde_json::Value) -> String {
         } else {
             "no"
         },
+        rattle = HELD_RATTLE_RAD,
     )
 }
