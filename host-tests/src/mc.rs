@@ -56,10 +56,6 @@ pub struct Outcome {
     pub latency_s: Option<f64>,
     /// Whether the fault manifested within the scene.
     pub manifested: bool,
-    /// The fault's onset fell in the monitor's settling time after power-on (the twin's scenes
-    /// start with the monitor's power-on, mid-drive): it met a monitor with no healthy
-    /// reference yet (reported apart, counted in the rate like any other run).
-    pub onset_before_settled: bool,
     /// Where the fault fell, for reading the misses (`None` in a nominal run).
     pub context: Option<Context>,
     /// Flags raised before the fault's onset (all flags in a nominal run).
@@ -68,12 +64,22 @@ pub struct Outcome {
     pub error: Option<String>,
 }
 
+/// When, after power-on mid-drive, the drive checks have a history to judge a step against
+/// (s): the observer's settling (`thresholds.settle_time_s`), when the driving reading is first
+/// decided, plus the phase settling that follows a change of scene
+/// (`thresholds.engage_settle_s`); the history is seeded then.
+pub fn checks_armed_s() -> f64 {
+    let t = &Config::default().thresholds;
+    t.settle_time_s + t.engage_settle_s
+}
+
 /// Where a fault fell in its run: the classes the misses are reported by (docs/monitor.md).
 /// The first that applies.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Context {
-    /// The onset fell in the monitor's settling time after power-on (the scenes start
-    /// mid-drive with it): no healthy reference yet.
+    /// The onset fell before the drive checks were armed after power-on ([`checks_armed_s`];
+    /// the scenes start mid-drive with it): no healthy reference yet — a drag or a current gain
+    /// already there is read as part of the load, which only the current measures.
     Settling,
     /// The drive was running at the onset and was cut before the drive checks' phase settling
     /// (`thresholds.engage_settle_s`) had passed: the fault met less drive than any drive check
@@ -102,7 +108,7 @@ impl Context {
         let mut after = trace.rows.iter().skip_while(|r| r.t_s < at_s);
         let driving_at_onset = after.clone().next().is_some_and(|r| r.drive_on);
         let cut = after.find(|r| !r.drive_on).map(|r| r.t_s);
-        if at_s - start < t.settle_time_s {
+        if at_s - start < checks_armed_s() {
             Context::Settling
         } else if driving_at_onset && cut.is_some_and(|c| c - at_s < t.engage_settle_s) {
             Context::ShortDrive
@@ -229,7 +235,6 @@ pub fn evaluate(d: &Draw) -> Outcome {
         fault: fault.map(|f| f.kind),
         latency_s: None,
         manifested: false,
-        onset_before_settled: false,
         context: None,
         false_flags: 0,
         error: Some(e),
@@ -250,10 +255,6 @@ pub fn evaluate(d: &Draw) -> Outcome {
         fault: fault.map(|f| f.kind),
         latency_s: fault.and_then(|f| detection_latency_s(&f, &trace, &acc)),
         manifested: fault.is_some_and(|f| manifest_time(&f, &trace).is_some()),
-        onset_before_settled: fault.is_some_and(|f| {
-            let start = trace.rows.first().map_or(0.0, |r| r.t_s);
-            f.at_s - start < Config::default().thresholds.settle_time_s
-        }),
         context: fault.map(|f| Context::of(f.at_s, &trace, d.scene.kind)),
         false_flags: acc.flags.iter().filter(|f| f.t_s < onset).count(),
         error: None,

@@ -7,7 +7,9 @@ use crate::shell::workspace_root;
 use host_tests::accuracy::{
     compare, run_monitor, COMPARE_WINDOW_S, FAILED_HOLD_SLIP_S, HELD_RATTLE_RAD,
 };
-use host_tests::mc::{draw, run_all, Context, Outcome, DETECTION_WINDOW_S, FAULT_KINDS};
+use host_tests::mc::{
+    checks_armed_s, draw, run_all, Context, Outcome, DETECTION_WINDOW_S, FAULT_KINDS,
+};
 use noback::monitor::Config;
 use serde_json::json;
 use std::fmt::Write as _;
@@ -106,7 +108,9 @@ pub fn main(args: &[String]) -> Result<i32, String> {
         all_ok &= rate.is_some_and(|r| r >= DETECTION_TARGET);
         // The same among the runs whose onset came after the monitor had settled (shown apart;
         // the target is on the whole column).
-        let settled = manifested.iter().filter(|o| !o.onset_before_settled);
+        let settled = manifested
+            .iter()
+            .filter(|o| o.context != Some(Context::Settling));
         let detected_settled = settled
             .clone()
             .filter(|o| o.latency_s.is_some_and(|l| l <= DETECTION_WINDOW_S))
@@ -333,9 +337,11 @@ fn doc(a: &Args, r: &serde_json::Value) -> String {
          - *Onset after settling* (the last two columns, for reading the misses; the target is \
          on the whole `rate` column): the twin's scenes start mid-drive with the monitor's \
          power-on, so a fault whose onset falls in the monitor's first {:.0} ms (its settling \
-         time, `thresholds.settle_time_s`) meets a monitor that has not yet seen the healthy \
-         drive — a drag or a current gain already there is read as part of the load, which \
-         only the current measures. The columns give the rate among the other runs.\n\
+         time, `thresholds.settle_time_s`, and the phase settling after the driving reading is \
+         first decided, `thresholds.engage_settle_s`: then the drive checks seed their history) \
+         meets a monitor that has not yet seen the healthy drive — a drag or a current gain \
+         already there is read as part of the load, which only the current measures. The \
+         columns give the rate among the other runs.\n\
          - Accuracy: the twin's pressing force and braking torque are compared after a centred \
          {:.0} ms moving average (the monitor sees ball–socket impacts only as the output's inertia torque over 3.2 ms); \
          `cargo xtask monitor SCENE` plots raw and compared signals.\n\n\
@@ -347,7 +353,7 @@ fn doc(a: &Args, r: &serde_json::Value) -> String {
         FAILED_HOLD_SLIP_S * 1e3,
         DETECTION_WINDOW_S * 1e3,
         DETECTION_TARGET * 100.0,
-        Config::default().thresholds.settle_time_s * 1e3,
+        checks_armed_s() * 1e3,
         COMPARE_WINDOW_S * 1e3,
         table(r),
         if r["targets_met"] == true {
