@@ -59,10 +59,18 @@
 //!
 //! # Cost
 //! `cargo xtask run --json` (Cortex-M3 under QEMU, the twin's reverse_load trace, release, LTO):
-//! mean 867.5, max 983 instructions per step (budget 1000; the worst step per scene is in the
+//! mean 848.5, max 989 instructions per step (budget 1000; the worst step per scene is in the
 //! command's `insns_per_step_max_by_scene`). The periodic parts (load filter or pack health,
 //! drive checks, friction energy, load-cache refresh) each have their own tick modulo 4, so
 //! that no step carries two of them (`step`, "Cost"; docs/monitor-design.md, "Cost").
+//!
+//! # Power-on
+//! A monitor may be powered on (or reset) into a running actuator. After
+//! [`POWER_ON_SEED_TICKS`] on-time ticks the observer starts from the output's measured speed,
+//! its torque balanced, instead of at rest, and the estimate settles in
+//! `thresholds.power_on_settle_s` (30 ms) instead of `settle_time_s` (0.1 s): the drive checks
+//! are armed ≈ 52 ms after power-on. A late tick or an implausible sample meanwhile leaves it to
+//! settle from rest (docs/monitor-design.md, "Power-on into a running drive").
 //!
 //! # Missed ticks
 //! The caller sets [`Inputs::ticks_elapsed`] to the number of ticks since the previous call
@@ -79,7 +87,7 @@ mod slip_check;
 
 pub use config::{
     Config, ConfigError, ObserverGains, Thresholds, DEFAULT_BRAKING_MODEL_HZ,
-    DEFAULT_OBSERVER_BANDWIDTH_HZ, DEFAULT_TICK_HZ,
+    DEFAULT_OBSERVER_BANDWIDTH_HZ, DEFAULT_TICK_HZ, POWER_ON_SEED_TICKS,
 };
 pub use io::{BrakeState, Estimate, Flags, Inputs, Scene, SceneModel, ESTIMATE_WORDS};
 pub use scale::{recip_q16, sat_i32, Scale, ScaleError};
@@ -149,6 +157,8 @@ pub struct Monitor {
     phase_ticks: u32,
     settle_ticks: u32,
     since_fault: u32,
+    /// The observer's seeding after power-on.
+    seed: PowerOnSeed,
     rail_ticks: u32,
     /// Recent peak |ω̂| (Q16 bits), decaying at `impact_decay` per tick: the energy an impact
     /// in the lost motion can still return.
@@ -255,6 +265,53 @@ impl BrakingEnvelope {
     }
 }
 
+/// The observer's seeding after power-on (docs/monitor-design.md, "Power-on into a running
+/// drive"): after [`POWER_ON_SEED_TICKS`] on-time, plausible ticks the observer starts from the
+/// output's measured speed with the torque balanced, instead of at rest.
+#[derive(Clone, Copy, Debug, Default)]
+struct PowerOnSeed {
+    /// Ticks left (0: done, or given up on a late or implausible tick).
+    left: u32,
+    /// Output counter at power-on (masked).
+    out: u32,
+    /// Output counter at the previous tick (masked), for the plausibility of each step.
+    last: u32,
+}
+
+impl PowerOnSeed {
+    /// One tick while `left > 0` (out of line: the other ticks carry only that test). Returns
+    /// the seeded observer when the last seeding tick has passed: the angle read now, the
+    /// speed from the travel since power-on, and `d̂ = T̂ − u` (the previous tick's drive and
+    /// model torques) so that the model does not accelerate. A late tick, a sensor fault
+    /// (`give_up`) or an output step beyond the plausible speed ends the seeding: the observer
+    /// then settles from rest, the usual way.
+    #[cold]
+    #[inline(never)]
+    fn tick(
+        &mut self,
+        give_up: bool,
+        out_now: u32,
+        measured: u32,
+        drive_torque: i32,
+        brake_model: Q16,
+        p: &Params,
+    ) -> Option<Observer> {
+        let step = counter_delta(self.last, out_now, p.out_bits);
+        self.last = out_now;
+        if give_up || step.saturating_abs() > p.out_jump_counts {
+            self.left = 0;
+            return None;
+        }
+        self.left = self.left.saturating_sub(1);
+        (self.left == 0).then(|| Observer {
+            theta: measured,
+            v: p.seed_speed
+                .apply(counter_delta(self.out, out_now, p.out_bits)),
+            d: brake_model.to_bits().saturating_sub(drive_torque),
+        })
+    }
+}
+
 /// `x·n` for a tick count `n ≥ 1`, **saturating**; free when `n = 1` (every on-time step).
 trait Times {
     fn times(self, n: i32) -> i32;
@@ -321,6 +378,7 @@ impl Monitor {
             phase_ticks: 0,
             settle_ticks: 0,
             since_fault: 0,
+            seed: PowerOnSeed::default(),
             rail_ticks: 0,
             impact_speed: 0,
             last_dir: 0,
@@ -452,6 +510,23 @@ impl Monitor {
         let out_now = inputs.output_counter & p.out_mask;
         let motor_now = inputs.motor_counter & p.motor_mask;
         let measured = out_now << p.out_shift;
+        // ---- Power-on seeding (out of line: the other ticks carry only this test; from the
+        // tick after power-on, so that the first tick does not carry it either).
+        if self.seed.left > 0 {
+            let (u, brake) = (self.drive_torque.to_bits(), self.brake_model);
+            if let Some(obs) = self
+                .seed
+                .tick(n != 1 || fault, out_now, measured, u, brake, p)
+            {
+                self.obs = obs;
+                let head = p.power_on_head_start;
+                self.settle_ticks = self.settle_ticks.saturating_add(head);
+                self.since_fault = self.since_fault.saturating_add(head);
+                if drive {
+                    self.drive_ticks = self.drive_ticks.saturating_add(head);
+                }
+            }
+        }
         if !self.started {
             self.started = true;
             self.prev_out = out_now;
@@ -463,6 +538,11 @@ impl Monitor {
                 theta: measured,
                 v: 0,
                 d: 0,
+            };
+            self.seed = PowerOnSeed {
+                left: POWER_ON_SEED_TICKS,
+                out: out_now,
+                last: out_now,
             };
         }
         let d_out = counter_delta(self.prev_out, out_now, p.out_bits);

@@ -6,6 +6,8 @@
 //! with load 5–30 N·m, speed 5–20 rad/s, every mechanism parameter of Table 2 scaled by an
 //! independent factor in [0.9, 1.1], current noise 0–0.1 A, and the load in either direction
 //! (a mirrored run: every sensor reading negated, which is the mechanism's symmetry).
+//! Each draw's twin run starts [`PRE_ROLL_S`] before the monitor is powered on: the monitor
+//! meets a running actuator, not the twin's start-up transient; times are from its power-on.
 //! Fault draws: the same, plus one fault of the given kind with onset uniform in the scene and
 //! severity in [0.5, 1]. A fault is detected when a flag that answers its kind
 //! ([`crate::accuracy::expected_flag`]) rises within [`DETECTION_WINDOW_S`] of the moment it
@@ -64,22 +66,25 @@ pub struct Outcome {
     pub error: Option<String>,
 }
 
-/// When, after power-on mid-drive, the drive checks have a history to judge a step against
-/// (s): the observer's settling (`thresholds.settle_time_s`), when the driving reading is first
+/// When, after power-on into a running drive, the drive checks have a history to judge a
+/// step against (s): the observer's seeding ([`noback::monitor::POWER_ON_SEED_TICKS`]) and
+/// the settling after it (`thresholds.power_on_settle_s`), when the driving reading is first
 /// decided, plus the phase settling that follows a change of scene
 /// (`thresholds.engage_settle_s`); the history is seeded then.
-pub fn checks_armed_s() -> f64 {
-    let t = &Config::default().thresholds;
-    t.settle_time_s + t.engage_settle_s
+pub fn checks_armed_s(config: &Config) -> f64 {
+    let t = &config.thresholds;
+    f64::from(noback::monitor::POWER_ON_SEED_TICKS) / config.tick_hz
+        + t.power_on_settle_s
+        + t.engage_settle_s
 }
 
 /// Where a fault fell in its run: the classes the misses are reported by (docs/monitor.md).
 /// The first that applies.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Context {
-    /// The onset fell before the drive checks were armed after power-on ([`checks_armed_s`];
-    /// the scenes start mid-drive with it): no healthy reference yet — a drag or a current gain
-    /// already there is read as part of the load, which only the current measures.
+    /// The onset fell before the drive checks were armed after power-on ([`checks_armed_s`]):
+    /// no healthy reference yet — a drag or a current gain already there is read as part of the
+    /// load, which only the current measures.
     Settling,
     /// The drive was running at the onset and was cut before the drive checks' phase settling
     /// (`thresholds.engage_settle_s`) had passed: the fault met less drive than any drive check
@@ -101,14 +106,15 @@ impl Context {
         Context::Other,
     ];
 
-    /// The context of a fault with onset `at_s` in `trace` of a `kind` scene.
-    pub fn of(at_s: f64, trace: &Trace, kind: SceneKind) -> Context {
-        let t = &Config::default().thresholds;
+    /// The context of a fault with onset `at_s` in `trace` of a `kind` scene, for a monitor
+    /// configured with `config`.
+    pub fn of(at_s: f64, trace: &Trace, kind: SceneKind, config: &Config) -> Context {
+        let t = &config.thresholds;
         let start = trace.rows.first().map_or(0.0, |r| r.t_s);
         let mut after = trace.rows.iter().skip_while(|r| r.t_s < at_s);
         let driving_at_onset = after.clone().next().is_some_and(|r| r.drive_on);
         let cut = after.find(|r| !r.drive_on).map(|r| r.t_s);
-        if at_s - start < checks_armed_s() {
+        if at_s - start < checks_armed_s(config) {
             Context::Settling
         } else if driving_at_onset && cut.is_some_and(|c| c - at_s < t.engage_settle_s) {
             Context::ShortDrive
@@ -213,9 +219,38 @@ pub fn mirror(trace: &mut Trace, adc_bits: u8, motor_bits: u8, output_bits: u8) 
     }
 }
 
-/// The sensor trace of one draw: the twin's run of its scene, mirrored when the draw says so.
+/// How long the twin runs each draw's scene before the monitor is powered on (s): the twin's
+/// scenes start mid-drive from a state that is not its drive's equilibrium (the proportional
+/// speed servo starts with no speed error, so the drive torque swings from 0 to past its steady
+/// value and back over the first ≈ 0.1 s), which no monitor powered on into a running
+/// actuator meets. The scene's cut and fault onsets are shifted by it; the trace the monitor
+/// sees starts after it, with its time origin at the monitor's power-on.
+pub const PRE_ROLL_S: f64 = 0.2;
+
+/// The sensor trace of one draw: the twin's run of its scene after [`PRE_ROLL_S`], mirrored
+/// when the draw says so.
 pub fn draw_trace(d: &Draw) -> Result<Trace, String> {
-    let mut trace = scene_trace(&d.scene)?;
+    draw_trace_after(d, PRE_ROLL_S)
+}
+
+/// [`draw_trace`] with the monitor powered on `pre_roll_s` into the twin's run (0: at the
+/// scene's start, in the twin's own start-up transient, as the campaigns before the pre-roll
+/// did).
+pub fn draw_trace_after(d: &Draw, pre_roll_s: f64) -> Result<Trace, String> {
+    let mut scene = d.scene.clone();
+    scene.duration_s += pre_roll_s;
+    if let Some(release) = scene.release_at_s.as_mut() {
+        *release += pre_roll_s;
+    }
+    for f in &mut scene.faults {
+        f.at_s += pre_roll_s;
+    }
+    let mut trace = scene_trace(&scene)?;
+    let skip = (pre_roll_s * trace.sample_rate_hz).round() as usize;
+    trace.rows.drain(..skip.min(trace.rows.len()));
+    for r in &mut trace.rows {
+        r.t_s -= pre_roll_s;
+    }
     let s = &d.scene.sensors;
     if d.mirrored {
         mirror(
@@ -228,8 +263,28 @@ pub fn draw_trace(d: &Draw) -> Result<Trace, String> {
     Ok(trace)
 }
 
+/// What a campaign runs the draws with: the monitor's configuration and the pre-roll (the
+/// defaults are the shipped monitor and [`PRE_ROLL_S`]; others serve the ablations in
+/// docs/monitor-design.md, `cargo xtask monitor-mc --power-on-settle S --pre-roll S`).
+#[derive(Clone, Copy, Debug)]
+pub struct Campaign {
+    /// The monitor's configuration.
+    pub config: Config,
+    /// How long the twin runs before the monitor is powered on (s).
+    pub pre_roll_s: f64,
+}
+
+impl Default for Campaign {
+    fn default() -> Self {
+        Campaign {
+            config: Config::default(),
+            pre_roll_s: PRE_ROLL_S,
+        }
+    }
+}
+
 /// Runs one draw through the twin and the monitor.
-pub fn evaluate(d: &Draw) -> Outcome {
+pub fn evaluate(d: &Draw, campaign: &Campaign) -> Outcome {
     let fault = d.scene.faults.first().copied();
     let fail = |e: String| Outcome {
         fault: fault.map(|f| f.kind),
@@ -239,13 +294,13 @@ pub fn evaluate(d: &Draw) -> Outcome {
         false_flags: 0,
         error: Some(e),
     };
-    let trace = match draw_trace(d) {
+    let trace = match draw_trace_after(d, campaign.pre_roll_s) {
         Ok(trace) => trace,
         Err(e) => return fail(e),
     };
     // The monitor is configured with the nominal Table 2, not the drawn mechanism: it must
     // cope with a ±10 % real part.
-    let estimates = match run_monitor(&trace, Config::default()) {
+    let estimates = match run_monitor(&trace, campaign.config) {
         Ok(e) => e,
         Err(e) => return fail(e),
     };
@@ -255,7 +310,7 @@ pub fn evaluate(d: &Draw) -> Outcome {
         fault: fault.map(|f| f.kind),
         latency_s: fault.and_then(|f| detection_latency_s(&f, &trace, &acc)),
         manifested: fault.is_some_and(|f| manifest_time(&f, &trace).is_some()),
-        context: fault.map(|f| Context::of(f.at_s, &trace, d.scene.kind)),
+        context: fault.map(|f| Context::of(f.at_s, &trace, d.scene.kind, &campaign.config)),
         false_flags: acc.flags.iter().filter(|f| f.t_s < onset).count(),
         error: None,
     }
@@ -264,6 +319,7 @@ pub fn evaluate(d: &Draw) -> Outcome {
 /// Runs every draw on `threads` workers, calling `progress(done, total)` as runs finish.
 pub fn run_all(
     draws: &[Draw],
+    campaign: &Campaign,
     threads: usize,
     progress: &(dyn Fn(usize, usize) + Sync),
 ) -> Vec<Outcome> {
@@ -274,7 +330,7 @@ pub fn run_all(
             scope.spawn(|| loop {
                 let i = next.fetch_add(1, Ordering::Relaxed);
                 let Some(d) = draws.get(i) else { break };
-                let outcome = evaluate(d);
+                let outcome = evaluate(d, campaign);
                 let done = {
                     let mut r = results.lock().unwrap_or_else(|p| p.into_inner());
                     r[i] = Some(outcome);

@@ -277,6 +277,15 @@ fn constructor_rejects_out_of_range_parameters() {
             parameter: "sensors.reducer_efficiency"
         }
     );
+    // A seeded power-on settles sooner than the observer's full settling, never later.
+    let mut c = Config::default();
+    c.thresholds.power_on_settle_s = c.thresholds.settle_time_s + 0.01;
+    assert_eq!(
+        err(c),
+        ConfigError::OutOfRange {
+            parameter: "thresholds.power_on_settle_s"
+        }
+    );
     let mut c = Config::default();
     c.thresholds.impact_time_s = 0.0;
     assert_eq!(
@@ -452,5 +461,42 @@ fn errors_name_their_parameter_in_the_message() {
     assert_eq!(
         e.to_string(),
         "monitor configuration: capacity_mu overflows the fixed-point format"
+    );
+}
+
+/// Powered on into a running drive, the observer starts from the output's measured speed once
+/// `POWER_ON_SEED_TICKS` ticks have passed, not from rest — unless a tick is late meanwhile:
+/// then it settles from rest, the usual way (docs/monitor-design.md, "Power-on into a running
+/// drive").
+#[test]
+fn power_on_into_a_running_drive_seeds_the_observer_speed_unless_a_tick_is_late() {
+    let sensors = Config::default().sensors;
+    let out_per_tick = 3_u32; // 3 counts a tick: 11.5 rad/s
+    let speed = f64::from(out_per_tick) * sensors.output_rad_per_count() * 10_000.0;
+    let motor_per_out = sensors.output_rad_per_count() / sensors.input_rad_per_motor_count();
+    let speed_after = |late_at: Option<u32>| {
+        let mut m = Monitor::new(Config::default()).unwrap();
+        let mut e = None;
+        let mut ticks = 0_u32;
+        for k in 0..noback::monitor::POWER_ON_SEED_TICKS + 4 {
+            let n = if late_at == Some(k) { 2 } else { 1 };
+            ticks += n;
+            let out = (1000 + out_per_tick * ticks) & 0x3FFF;
+            let motor = (f64::from(out_per_tick * ticks) * motor_per_out) as u32 & 0xFFFF;
+            let mut inputs = Inputs::new(MID + 200, motor, out, true);
+            inputs.ticks_elapsed = n as u8;
+            e = Some(m.step(&inputs));
+        }
+        e.map_or(f64::NAN, |e| e.output_speed_rad_s.to_num::<f64>())
+    };
+    let seeded = speed_after(None);
+    assert!(
+        (seeded - speed).abs() < 0.02 * speed,
+        "seeded {seeded} rad/s, moving at {speed}"
+    );
+    let from_rest = speed_after(Some(5));
+    assert!(
+        from_rest < 0.5 * speed,
+        "a late tick should leave the observer to settle from rest: {from_rest} rad/s"
     );
 }

@@ -5,13 +5,15 @@
 //! a false `brake_drag` at 0.158 s; with it the run is clean.
 
 use host_tests::accuracy::{compare, run_monitor};
-use host_tests::mc::{draw_among, draw_trace, SCENE_KINDS};
+use host_tests::mc::{draw_among, draw_trace_after, SCENE_KINDS};
 use noback::monitor::{Config, Scene};
 
 #[test]
 fn a_change_of_reading_while_driving_raises_nothing() {
-    // Drawn as the campaign drew it then, among the first four scene kinds.
-    let trace = draw_trace(&draw_among(&SCENE_KINDS[..4], 2026, 348, None)).expect("twin");
+    // Drawn as the campaign drew it then, among the first four scene kinds, and powered on at
+    // the scene's start as then (in the twin's start-up transient).
+    let trace =
+        draw_trace_after(&draw_among(&SCENE_KINDS[..4], 2026, 348, None), 0.0).expect("twin");
     let estimates = run_monitor(&trace, Config::default()).expect("monitor");
     // The run does change its driving reading (else it would not test the transfer).
     let mut changes = 0;

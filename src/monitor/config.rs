@@ -141,8 +141,14 @@ pub struct Thresholds {
     pub sync_speed_band_rad_s: f64,
     /// A brake condition must persist this long before its flag latches (s).
     pub flag_persistence_s: f64,
-    /// Observer settling time after power-on or re-initialisation (s); untrusted meanwhile.
+    /// Observer settling time after a re-initialisation (a late step beyond the catch-up) or
+    /// a power-on that could not be seeded (s); untrusted meanwhile.
     pub settle_time_s: f64,
+    /// Settling time after power-on when the observer could be seeded from the first
+    /// [`POWER_ON_SEED_TICKS`] ticks (speed from the output encoder's travel, torque balanced
+    /// so that the output does not accelerate): it starts near the motion instead of at rest
+    /// (s; at most `settle_time_s`).
+    pub power_on_settle_s: f64,
     /// Time after the ramps engage before the pack health is learned (ramp backlash) (s).
     pub engage_settle_s: f64,
     /// Bandwidth of the load-estimate filter (Hz).
@@ -193,6 +199,7 @@ impl Thresholds {
         sync_speed_band_rad_s: 1.0,
         flag_persistence_s: 0.01,
         settle_time_s: 0.1,
+        power_on_settle_s: 0.03,
         engage_settle_s: 0.02,
         load_filter_hz: 10.0,
         input_speed_filter_hz: 200.0,
@@ -384,6 +391,10 @@ pub(crate) struct Params {
     pub braking_speed: Scale<30>,
     pub persistence_ticks: u32,
     pub settle_ticks: u32,
+    /// Ticks of settling a seeded power-on skips (`settle_time_s − power_on_settle_s`).
+    pub power_on_head_start: u32,
+    /// Output counts over the seeding window → Q16 rad/s.
+    pub seed_speed: Scale<16>,
     pub engage_settle_ticks: u32,
     pub braking_grace_ticks: u32,
     pub creep_counts: i32,
@@ -493,6 +504,9 @@ fn counts(x: f64, parameter: &'static str) -> Result<i32, ConfigError> {
     }
     Ok(((x + 0.5) as i32).max(1))
 }
+
+/// Ticks after power-on over which the observer's starting speed is measured.
+pub const POWER_ON_SEED_TICKS: u32 = 16;
 
 /// Ticks over which the output's and the input shaft's travel are compared for synchronism
 /// (`Monitor::step`, "steady driving").
@@ -832,6 +846,20 @@ impl Params {
                 "thresholds.flag_persistence_s",
             )?,
             settle_ticks: ticks(t.settle_time_s, tick_hz, "thresholds.settle_time_s")?,
+            power_on_head_start: {
+                let settle = ticks(t.settle_time_s, tick_hz, "thresholds.settle_time_s")?;
+                let power_on = ticks(t.power_on_settle_s, tick_hz, "thresholds.power_on_settle_s")?;
+                // A seeded start settles sooner, never later.
+                settle
+                    .checked_sub(power_on)
+                    .ok_or(ConfigError::OutOfRange {
+                        parameter: "thresholds.power_on_settle_s",
+                    })?
+            },
+            seed_speed: scale(
+                out_rad / h * Q16_ONE / f64::from(POWER_ON_SEED_TICKS),
+                "sensors.output_encoder_bits",
+            )?,
             engage_settle_ticks: ticks(t.engage_settle_s, tick_hz, "thresholds.engage_settle_s")?,
             braking_grace_ticks: ticks(t.braking_grace_s, tick_hz, "thresholds.braking_grace_s")?,
             creep_counts: counts(

@@ -62,7 +62,7 @@ pub const COMMANDS: &[(&str, &str)] = &[
     ),
     (
         "monitor-mc",
-        "[--runs N] [--fault-runs K] [--seed S] [--json]: detection by Monte Carlo; writes docs/monitor.md",
+        "[--runs N] [--fault-runs K] [--seed S] [--json] [--no-doc] [--power-on-settle S] [--pre-roll S]: detection by Monte Carlo; writes docs/monitor.md",
     ),
     (
         "fuzz",
