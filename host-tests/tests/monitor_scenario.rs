@@ -669,7 +669,12 @@ mod envelope {
     }
 
     /// For a load against the motion whose steady drive torque `v` also fits an overrunning
-    /// load `M' = y(v) − v` inside the envelope, `Some(M')` (signed along the motion).
+    /// load `M' = y(v) − v` inside the envelope, `Some(M')` (signed along the motion). The
+    /// envelope's edges are widened by what the monitor cannot resolve there: `M'` moves by
+    /// `dM'/dv ≈ 5.9` per N·m of drive torque, and the drive torque is read to the current's
+    /// resolution through the plant's ADC noise (`adc_noise + 1` counts, 0.02 N·m a count:
+    /// ±0.35 N·m of `M'`). A load that close to an edge may be read either way (seen at
+    /// `M'` = 60.2 N·m, 10.27 N·m against at 2 rad/s: the monitor's `M'` converges to 59.9).
     fn ambiguous_reading(plant: &Plant, load: f64, speed: f64) -> Option<f64> {
         let m = TABLE2;
         if load * speed >= 0.0 {
@@ -679,8 +684,14 @@ mod envelope {
         let ak = a * m.ramp_factor_per_m();
         let v = load.abs() + plant.drive_drag(-load.abs());
         let along = (2.0 * ak * v - a * m.spring_preload_n()) / (ak - 1.0) - v;
+        let per_count = plant
+            .sensors
+            .input_torque_nm(plant.sensors.amps_per_count());
+        let slope = 2.0 * ak / (ak - 1.0) - 1.0;
+        let edge = slope * f64::from(plant.adc_noise + 1) * per_count;
         let t = Config::default().thresholds;
-        (along > t.min_load_nm && along <= t.max_load_nm).then_some(speed.signum() * along)
+        (along > t.min_load_nm - edge && along <= t.max_load_nm + edge)
+            .then_some(speed.signum() * along)
     }
 
     proptest! {
