@@ -553,6 +553,30 @@ fn nominal_restart_raises_nothing() {
     assert!((hold + 10.0).abs() <= 0.5, "{hold}");
 }
 
+/// Powered on at rest with the drive starting at once (the ideal servo accelerating at
+/// 50 rad/s² to its speed): the power-on seeding finds the output still, so the observer starts
+/// at rest with its torque balanced, and the drive checks, armed after the short power-on
+/// settling, must not read the start as a drag or a lost current gain — at either load
+/// direction and at the drive envelope's speeds.
+#[test]
+fn power_on_with_the_drive_starting_from_rest_raises_nothing() {
+    for load in [-25.0, -10.0, 10.0, 25.0] {
+        for speed in [5.0, 20.0] {
+            let mut plant = Plant::new(load, 0.0);
+            let mut monitor = Monitor::new(Config::default()).unwrap();
+            let trace = run(&mut plant, &mut monitor, speed, 0.6, 1.2);
+            let flagged = trace.iter().find(|x| x.2.flags.any());
+            assert!(
+                flagged.is_none(),
+                "load {load}, {speed} rad/s: {:?} at {:?} s",
+                flagged.map(|x| x.2.flags),
+                flagged.map(|x| x.0)
+            );
+            assert_eq!(trace.last().map(|x| x.2.brake), Some(BrakeState::Locked));
+        }
+    }
+}
+
 mod envelope {
     //! Property tests over the operating envelope: the fixed-point step against f64 shadows.
 
