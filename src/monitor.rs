@@ -59,7 +59,7 @@
 //!
 //! # Cost
 //! `cargo xtask run --json` (Cortex-M3 under QEMU, the twin's reverse_load trace, release, LTO):
-//! mean 848.5, max 989 instructions per step (budget 1000; the worst step per scene is in the
+//! mean 841.2, max 983 instructions per step (budget 1000; the worst step per scene is in the
 //! command's `insns_per_step_max_by_scene`). The periodic parts (load filter or pack health,
 //! drive checks, friction energy, load-cache refresh) each have their own tick modulo 4, so
 //! that no step carries two of them (`step`, "Cost"; docs/monitor-design.md, "Cost").
@@ -274,8 +274,6 @@ struct PowerOnSeed {
     left: u32,
     /// Output counter at power-on (masked).
     out: u32,
-    /// Output counter at the previous tick (masked), for the plausibility of each step.
-    last: u32,
 }
 
 impl PowerOnSeed {
@@ -283,28 +281,27 @@ impl PowerOnSeed {
     /// the seeded observer when the last seeding tick has passed: the angle read now, the
     /// speed from the travel since power-on, and `d̂ = T̂ − u` (the previous tick's drive and
     /// model torques) so that the model does not accelerate. A late tick, a sensor fault
-    /// (`give_up`) or an output step beyond the plausible speed ends the seeding: the observer
-    /// then settles from rest, the usual way.
+    /// (`give_up`) or an output step from `prev_out` beyond the plausible speed ends the
+    /// seeding: the observer then settles from rest, the usual way.
     #[cold]
     #[inline(never)]
     fn tick(
         &mut self,
         give_up: bool,
+        prev_out: u32,
         out_now: u32,
-        measured: u32,
         drive_torque: i32,
         brake_model: Q16,
         p: &Params,
     ) -> Option<Observer> {
-        let step = counter_delta(self.last, out_now, p.out_bits);
-        self.last = out_now;
+        let step = counter_delta(prev_out, out_now, p.out_bits);
         if give_up || step.saturating_abs() > p.out_jump_counts {
             self.left = 0;
             return None;
         }
         self.left = self.left.saturating_sub(1);
         (self.left == 0).then(|| Observer {
-            theta: measured,
+            theta: out_now << p.out_shift,
             v: p.seed_speed
                 .apply(counter_delta(self.out, out_now, p.out_bits)),
             d: brake_model.to_bits().saturating_sub(drive_torque),
@@ -516,7 +513,7 @@ impl Monitor {
             let (u, brake) = (self.drive_torque.to_bits(), self.brake_model);
             if let Some(obs) = self
                 .seed
-                .tick(n != 1 || fault, out_now, measured, u, brake, p)
+                .tick(n != 1 || fault, self.prev_out, out_now, u, brake, p)
             {
                 self.obs = obs;
                 let head = p.power_on_head_start;
@@ -542,7 +539,6 @@ impl Monitor {
             self.seed = PowerOnSeed {
                 left: POWER_ON_SEED_TICKS,
                 out: out_now,
-                last: out_now,
             };
         }
         let d_out = counter_delta(self.prev_out, out_now, p.out_bits);

@@ -362,17 +362,21 @@ mod tests {
     use noback_twin::trace::TraceRow;
     use std::f64::consts::TAU;
 
-    /// A 10 kHz truth trace, drive off, with the output angle and brake state given per sample.
-    fn trace(samples: impl Iterator<Item = (f64, u8)>) -> Trace {
+    /// A 10 kHz truth trace of `samples` rows, drive off, with the output angle and brake
+    /// state at each time given by `at`.
+    fn trace(samples: usize, at: impl Fn(f64) -> (f64, u8)) -> Trace {
         Trace {
             sample_rate_hz: 10_000.0,
-            rows: samples
-                .enumerate()
-                .map(|(i, (angle, brake_state))| TraceRow {
-                    t_s: i as f64 * 1e-4,
-                    output_angle_rad: angle,
-                    brake_state,
-                    ..TraceRow::default()
+            rows: (0..samples)
+                .map(|i| {
+                    let t_s = i as f64 * 1e-4;
+                    let (output_angle_rad, brake_state) = at(t_s);
+                    TraceRow {
+                        t_s,
+                        output_angle_rad,
+                        brake_state,
+                        ..TraceRow::default()
+                    }
                 })
                 .collect(),
         }
@@ -389,7 +393,7 @@ mod tests {
     #[test]
     fn a_frozen_output_reading_of_a_shaft_rattling_in_its_lost_motion_never_manifests() {
         // ±0.1 rad at 50 Hz for 0.5 s: a held output's rattle, whatever the encoder says.
-        let t = trace((0..5000).map(|i| (0.1 * (i as f64 * 1e-4 * 50.0 * TAU).sin(), 2)));
+        let t = trace(5000, |t| (0.1 * (50.0 * TAU * t).sin(), 2));
         assert_eq!(manifest_time(&fault(FaultKind::EncoderStuck), &t), None);
     }
 
@@ -397,7 +401,7 @@ mod tests {
     fn a_frozen_output_reading_manifests_when_the_shaft_leaves_the_held_rattle() {
         // The output runs away at 5 rad/s: 0.13 rad beyond its angle at the onset (0.01 s)
         // 26 ms later.
-        let t = trace((0..2000).map(|i| (5.0 * i as f64 * 1e-4, 0)));
+        let t = trace(2000, |t| (5.0 * t, 0));
         let at = manifest_time(&fault(FaultKind::EncoderStuck), &t).expect("manifests");
         assert!((at - 0.0361).abs() < 2e-4, "{at}");
     }
@@ -406,14 +410,13 @@ mod tests {
     fn a_failing_hold_manifests_when_the_output_leaves_the_held_rattle() {
         // The pack opens at 0.05 s and the output accelerates from rest at 40 rad/s²: it passes
         // 0.13 rad after 80.6 ms, long after the 20 ms a failing hold must last.
-        let t = trace((0..3000).map(|i| {
-            let t = i as f64 * 1e-4;
+        let t = trace(3000, |t| {
             if t < 0.05 {
                 (0.0, 2)
             } else {
                 (20.0 * (t - 0.05) * (t - 0.05), 0)
             }
-        }));
+        });
         let at = manifest_time(&fault(FaultKind::PackWear), &t).expect("manifests");
         assert!((at - 0.1306).abs() < 2e-4, "{at}");
     }
@@ -421,11 +424,10 @@ mod tests {
     #[test]
     fn a_pack_that_opens_without_letting_the_output_go_never_manifests() {
         // Open for 30 ms, the output inside the rattle, then locked again.
-        let t = trace((0..3000).map(|i| {
-            let t = i as f64 * 1e-4;
+        let t = trace(3000, |t| {
             let open = (0.05..0.08).contains(&t);
             (if open { 0.05 } else { 0.0 }, if open { 0 } else { 2 })
-        }));
+        });
         assert_eq!(manifest_time(&fault(FaultKind::SpringBroken), &t), None);
     }
 }

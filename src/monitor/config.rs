@@ -794,6 +794,7 @@ impl Params {
                     * 4.0
                     * h,
             );
+        let settle_ticks = ticks(t.settle_time_s, tick_hz, "thresholds.settle_time_s")?;
         Ok(Params {
             adc_bits: s.current_adc_bits,
             adc_max_code: ((1_u32 << s.current_adc_bits) - 1) as u16,
@@ -845,17 +846,17 @@ impl Params {
                 tick_hz,
                 "thresholds.flag_persistence_s",
             )?,
-            settle_ticks: ticks(t.settle_time_s, tick_hz, "thresholds.settle_time_s")?,
-            power_on_head_start: {
-                let settle = ticks(t.settle_time_s, tick_hz, "thresholds.settle_time_s")?;
-                let power_on = ticks(t.power_on_settle_s, tick_hz, "thresholds.power_on_settle_s")?;
-                // A seeded start settles sooner, never later.
-                settle
-                    .checked_sub(power_on)
-                    .ok_or(ConfigError::OutOfRange {
-                        parameter: "thresholds.power_on_settle_s",
-                    })?
-            },
+            settle_ticks,
+            // A seeded start settles sooner, never later.
+            power_on_head_start: settle_ticks
+                .checked_sub(ticks(
+                    t.power_on_settle_s,
+                    tick_hz,
+                    "thresholds.power_on_settle_s",
+                )?)
+                .ok_or(ConfigError::OutOfRange {
+                    parameter: "thresholds.power_on_settle_s",
+                })?,
             seed_speed: scale(
                 out_rad / h * Q16_ONE / f64::from(POWER_ON_SEED_TICKS),
                 "sensors.output_encoder_bits",
