@@ -59,10 +59,11 @@
 //!
 //! # Cost
 //! `cargo xtask run --json` (Cortex-M3 under QEMU, the twin's reverse_load trace, release, LTO):
-//! mean 841.2, max 983 instructions per step (budget 1000; the worst step per scene is in the
-//! command's `insns_per_step_max_by_scene`). The periodic parts (load filter or pack health,
-//! drive checks, friction energy, load-cache refresh) each have their own tick modulo 4, so
-//! that no step carries two of them (`step`, "Cost"; docs/monitor-design.md, "Cost").
+//! mean 852.5, max 988 instructions per step (budget 1000; the worst step per scene is in the
+//! command's `insns_per_step_max_by_scene`: 995 on the hold scene). The periodic parts (load
+//! filter or pack health, drive checks, friction energy, load-cache refresh, synchronism window,
+//! dead-current-reading check) each have their own tick, so that no step carries two of them
+//! (`step`, "Cost"; docs/monitor-design.md, "Cost").
 //!
 //! # Power-on
 //! A monitor may be powered on (or reset) into a running actuator. After
@@ -79,6 +80,7 @@
 //! measurement and the estimate is untrusted until it settles again.
 
 mod config;
+mod dead_current;
 mod drive_checks;
 mod io;
 mod observer;
@@ -94,6 +96,7 @@ pub use scale::{recip_q16, sat_i32, Scale, ScaleError};
 
 use crate::fx::{adc_centered, counter_delta, lowpass, Q16};
 use config::{Params, SYNC_WINDOW_TICKS};
+use dead_current::DeadCurrent;
 use drive_checks::{DriveChecks, DriveTick};
 use fixed::types::U40F24;
 use observer::Observer;
@@ -123,6 +126,11 @@ const REFRESH_PHASE: u32 = 3;
 /// The tick (modulo [`SYNC_WINDOW_TICKS`]) on which the shafts' synchronism is measured: ≡ 3
 /// mod 4 like the refresh, which it never meets.
 const SYNC_PHASE: u32 = 7;
+
+/// The tick (modulo 16) on which the dead-current-reading check samples a running drive: ≡ 3
+/// mod 4 like the refresh and the synchronism window, which it never meets — the drive-on
+/// ticks with no other periodic work.
+const DEAD_CURRENT_PHASE: u32 = 15;
 
 /// Pack health is kept within [0, 2].
 const HEALTH_MAX: i32 = 2 << 16;
@@ -187,6 +195,8 @@ pub struct Monitor {
     weak_ticks: u32,
     /// The drag and step checks of a running drive.
     drive_checks: DriveChecks,
+    /// The dead-current-reading check of a running drive.
+    dead_current: DeadCurrent,
     /// Ticks of steady driving (the output moving with the input shaft), counted in steps of
     /// `SYNC_WINDOW_TICKS` on the synchronism tick: the load learning's and the drive checks'
     /// settling.
@@ -395,6 +405,7 @@ impl Monitor {
             still_motor: 0,
             weak_ticks: 0,
             drive_checks: DriveChecks::default(),
+            dead_current: DeadCurrent::default(),
             drive_ticks: 0,
             health: Q16::ONE,
             energy: U40F24::ZERO,
@@ -702,6 +713,7 @@ impl Monitor {
                 self.creep_counts = 0;
             }
             self.slip_check.disarm();
+            self.dead_current.disarm(out_now);
             self.drive_ticks = 0;
             self.prev_drive = drive;
         }
@@ -827,8 +839,10 @@ impl Monitor {
         let moving_ok = checks_ok && self.reading_ticks == 0;
         // Cost: the periodic work is spread over the ticks so that no step carries two of the
         // expensive parts. Tick modulo 4 — 0: the load filter (drive on) or the pack-health
-        // update (drive off); 1: the drive checks (drive on); 2: the friction energy; 3: the
-        // load cache's refresh (one in four, `REFRESH_PHASE` mod 16, drive on). The braking
+        // update (drive off); 1: the drive checks (drive on); 2: the friction energy; 3: with
+        // the drive on, by tick modulo 16, the load cache's refresh (`REFRESH_PHASE`), the
+        // synchronism window (`SYNC_PHASE`) and the dead-current-reading check
+        // (`DEAD_CURRENT_PHASE`). The braking
         // model's step (drive off, every `braking_model_ticks`) waits for an odd tick. Each
         // periodic part counts the ticks it covers; time constants and persistence are those
         // of the tick rate.
@@ -1047,6 +1061,23 @@ impl Monitor {
             } else {
                 0
             };
+        }
+        // A dead current reading: the output turns with the drive on, the pack has held it
+        // lately, and the drive torque averages next to nothing over a block of windows
+        // (dead_current.rs, out of line on a tick of its own), unless the load is known to be
+        // below the spring drag (a pack whose spring broke could then be driven by almost
+        // nothing). The step check cannot see it where its history never forms (overrunning
+        // chatter, where the load is never learned); once called, no `brake_drag` comes from
+        // this reading.
+        if drive
+            && self.tick & (SYNC_WINDOW_TICKS - 1) == DEAD_CURRENT_PHASE
+            && self.dead_current.window(self.drive_torque, out_now, p)
+            && settled
+            && sensors_ok
+            && !(self.load_known && self.load.saturating_abs() < p.drive_drag)
+        {
+            self.flags.sensor_fault = true;
+            self.drive_checks.suspect_current();
         }
         if self.tick & 3 == 1 {
             if drive && checks_ok && steady_drive {

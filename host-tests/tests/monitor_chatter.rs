@@ -12,7 +12,10 @@
 //! chatter at a heavy load and low speed, the start-up run-away at a light load and high speed,
 //! and the gentle engagement cycle at light loads.
 
-use host_tests::accuracy::monitor_on_scene;
+use host_tests::accuracy::{compare, monitor_on_scene, run_monitor};
+use host_tests::mc::{draw, draw_trace};
+use noback::monitor::Config;
+use noback_twin::fault::FaultKind;
 use noback_twin::reading::Reading;
 use noback_twin::scene::{Scene, SceneKind};
 
@@ -37,4 +40,39 @@ fn continuous_closing_across_loads_and_speeds_raises_nothing() {
         }
     }
     assert!(alarms.is_empty(), "false alarms: {alarms:?}");
+}
+
+/// Heavy continuous closings of the Monte Carlo (seed 2026) in which the current reading goes
+/// dead (an open sense circuit: `current_open` at severity ≈ 1) in the chatter. The shafts never
+/// stay synchronous there for the step check's 0.1 s and the load is never learned: before the
+/// dead-reading check (`monitor/dead_current.rs`) these went unflagged for the rest of the run.
+/// Now `sensor_fault` within 50 ms of the onset, and no `brake_drag` from the dead reading.
+#[test]
+fn a_current_reading_that_goes_dead_in_the_chatter_is_flagged_within_50_ms() {
+    for index in [281, 443] {
+        let d = draw(2026, index, Some(FaultKind::CurrentOpen));
+        let fault = d.scene.faults[0];
+        assert_eq!(d.scene.kind, SceneKind::ContinuousClosing);
+        assert!(fault.severity > 0.99, "{fault:?}");
+        let trace = draw_trace(&d).expect("twin");
+        let acc = compare(
+            &trace,
+            &run_monitor(&trace, Config::default()).expect("monitor"),
+        );
+        let flags = acc.flag_times();
+        println!(
+            "run {index}: load {:.1} N·m, input {:.1} rad/s, dead from {:.4} s: {flags:?}",
+            d.scene.load_torque_nm, d.scene.initial_speed_rad_s, fault.at_s
+        );
+        let first = flags.first().copied();
+        let window = fault.at_s..fault.at_s + 0.05;
+        assert!(
+            matches!(first, Some(("sensor_fault", t)) if window.contains(&t)),
+            "run {index}: {flags:?}"
+        );
+        assert!(
+            flags.iter().all(|(f, _)| *f != "brake_drag"),
+            "run {index}: {flags:?}"
+        );
+    }
 }

@@ -199,17 +199,20 @@ fn very_late_step_reseats_the_observer_and_is_untrusted() {
 
 #[test]
 fn missed_ticks_while_moving_keep_tracking() {
-    // 4 output counts per tick (15.3 rad/s), every fourth call covers two ticks.
+    // 4 output counts per tick (15.3 rad/s), every fourth call covers two ticks. The drive
+    // carries ≈ 3 N·m (150 ADC counts): a moving no-back's drive always carries some, and a
+    // reading of zero while the output turns is a dead current sensor (`sensor_fault`).
+    let code = MID + 150;
     let mut m = Monitor::new(Config::default()).unwrap();
     let (mut out, mut motor) = (0_u32, 0_u32);
-    let mut e = m.step(&Inputs::new(MID, motor, out, true));
+    let mut e = m.step(&Inputs::new(code, motor, out, true));
     for k in 0..4000_u32 {
         let n = if k % 4 == 3 { 2 } else { 1 };
         out = (out + 4 * n) & 0x3FFF;
         motor = (motor + 30 * n) & 0xFFFF;
         e = m.step(&Inputs {
             ticks_elapsed: n as u8,
-            ..Inputs::new(MID, motor, out, true)
+            ..Inputs::new(code, motor, out, true)
         });
     }
     assert!(e.flags.overrun && !e.flags.sensor_fault, "{:?}", e.flags);
@@ -284,6 +287,25 @@ fn constructor_rejects_out_of_range_parameters() {
         err(c),
         ConfigError::OutOfRange {
             parameter: "thresholds.power_on_settle_s"
+        }
+    );
+    // A dead current reading is one well below the spring drag a moving no-back's drive
+    // carries (1.98 N·m with Table 2): a threshold at or above it would call healthy drives
+    // dead.
+    let mut c = Config::default();
+    c.thresholds.dead_current_nm = 2.0;
+    assert_eq!(
+        err(c),
+        ConfigError::OutOfRange {
+            parameter: "thresholds.dead_current_nm"
+        }
+    );
+    let mut c = Config::default();
+    c.thresholds.dead_current_speed_rad_s = 0.0;
+    assert_eq!(
+        err(c),
+        ConfigError::OutOfRange {
+            parameter: "thresholds.dead_current_speed_rad_s"
         }
     );
     let mut c = Config::default();

@@ -166,6 +166,16 @@ pub struct Thresholds {
     pub current_off_max_a: f64,
     /// Time at an ADC rail before the current reading counts as failed (s).
     pub adc_rail_time_s: f64,
+    /// Mean drive torque (N·m, magnitude, over a block of 12.8 ms) below which the current
+    /// reading is dead while the drive is on, the output turns and the pack has lately held it
+    /// (`sensor_fault`; `monitor/dead_current.rs`). Must lie below the pack's spring drag
+    /// while driving (1.98 N·m with Table 2), around which a moving no-back's drive torque
+    /// sits at its lowest: healthy drives average ≥ 1.42 N·m over the blocks the check judges
+    /// in the Monte Carlo (`cargo run --release -p host-tests --example dead_current_margin`).
+    pub dead_current_nm: f64,
+    /// The output counts as turning for the dead-reading check above this mean speed over the
+    /// block (rad/s).
+    pub dead_current_speed_rad_s: f64,
     /// Rate at which the pack-health estimate may move (1/s, sign-LMS step).
     pub health_rate_per_s: f64,
     /// Time over which an impact in the lost motion may reverse the output speed before the
@@ -208,6 +218,8 @@ impl Thresholds {
         max_lost_motion_rad: 0.2, // the twin's lost motion is 0.03–0.1 rad
         current_off_max_a: 3.0,
         adc_rail_time_s: 0.01, // overrunning chatter stalls the motor at the current limit ≈ 3 ms
+        dead_current_nm: 0.5,  // healthy ≥ 1.37 N·m; a dead reading's noise ≤ 0.06 N·m
+        dead_current_speed_rad_s: 2.0,
         health_rate_per_s: 25.0,
         impact_time_s: 0.01,
         impact_window_s: 0.0016,
@@ -433,6 +445,12 @@ pub(crate) struct Params {
     pub step_alpha: Gain,
     /// Output counts of relative travel over [`SYNC_WINDOW_TICKS`] within the band.
     pub sync_band_counts: i32,
+    /// `dead_current_nm` × the dead-reading check's block of windows: the sum of the drive
+    /// torque samples below which a block reads dead (N·m).
+    pub dead_drive_sum: Q16,
+    /// `dead_current_speed_rad_s` as the output's travel summed over the block's windows
+    /// (counts): the output turns above it.
+    pub dead_travel_sum: i32,
     /// Motor counts → output counts (input shaft and output turn alike when synchronous).
     pub motor_to_out: Scale<30>,
     pub load_known_ticks: u32,
@@ -795,6 +813,15 @@ impl Params {
                     * h,
             );
         let settle_ticks = ticks(t.settle_time_s, tick_hz, "thresholds.settle_time_s")?;
+        // The dead-reading check judges the sum over a block of synchronism windows; its
+        // threshold must lie below the spring drag a moving no-back's drive always carries.
+        let block = f64::from(super::dead_current::BLOCK_WINDOWS);
+        let dead_current = positive(t.dead_current_nm, "thresholds.dead_current_nm")?;
+        if dead_current >= drive_drag {
+            return Err(ConfigError::OutOfRange {
+                parameter: "thresholds.dead_current_nm",
+            });
+        }
         Ok(Params {
             adc_bits: s.current_adc_bits,
             adc_max_code: ((1_u32 << s.current_adc_bits) - 1) as u16,
@@ -953,6 +980,17 @@ impl Params {
                 "thresholds.sync_speed_band_rad_s",
             )?,
             motor_to_out: scale(in_rad / out_rad, "sensors.motor_encoder_counts_per_rev")?,
+            dead_drive_sum: q16(dead_current * block, "thresholds.dead_current_nm")?,
+            dead_travel_sum: counts(
+                positive(
+                    t.dead_current_speed_rad_s,
+                    "thresholds.dead_current_speed_rad_s",
+                )? * f64::from(SYNC_WINDOW_TICKS)
+                    * h
+                    / out_rad
+                    * block,
+                "thresholds.dead_current_speed_rad_s",
+            )?,
             step_drive_min: q16(t.step_allowance_nm / 2.0, "thresholds.step_allowance_nm")?,
             drive_ref_shift: nearest_shift(step_alpha),
             step_alpha: gain(step_alpha, "thresholds.step_reference_hz")?,

@@ -74,6 +74,13 @@ impl DriveChecks {
         };
     }
 
+    /// Another check has found the current reading wrong (a dead reading): `brake_drag` is no
+    /// longer raised from it until the flags are reset.
+    #[inline]
+    pub fn suspect_current(&mut self) {
+        self.current_suspect = true;
+    }
+
     /// Forgets everything, the verdict on the current reading too (`Monitor::reset_flags`).
     #[inline]
     pub fn reset(&mut self) {
