@@ -1,5 +1,5 @@
-//! A dead current reading while the drive runs (`sensor_fault`): the output turns a known load
-//! with the drive on, and the current reads (almost) nothing.
+//! A dead current reading while the drive runs (`sensor_fault`): the output turns with the drive
+//! on, its pack holding it now and then, and the current reads (almost) nothing.
 //!
 //! Why it holds: a no-back moves only under its drive's torque while its pack works. Against
 //! the load the drive carries the load and the pack's spring drag; with the load along the
@@ -10,8 +10,8 @@
 //! least 1.42 N·m in 6000 nominal Monte Carlo draws (seeds 2026, 7 and 11, all of them in the
 //! chatter of continuous closing, where the drive torque passes through zero for up to ≈ 10 ms
 //! of each cycle: `cargo run --release -p host-tests --example dead_current_margin -- 2000
-//! SEED`). A reading that has lost (nearly) all its gain averages a few hundredths of a N·m
-//! plus its noise (≤ 0.06 N·m over a block at 0.1 A). The step check (`drive_checks.rs`) sees
+//! SEED`). A reading that has lost (nearly) all its gain averages what is left of it plus the
+//! magnitude of its noise (0.13 N·m at 0.1 A rms, the Monte Carlo's worst). The step check (`drive_checks.rs`) sees
 //! a gain loss of any size as a step against a steady history; in continuous closing's
 //! chatter that history never forms (the shafts do not stay synchronous for 0.1 s), and this
 //! check is what is left there — it sees only a reading that is dead or nearly so
@@ -36,7 +36,7 @@
 //!
 //! | quantity | format | range | resolution |
 //! |---|---|---|---|
-//! | drive torque sum | [`Q16`] N·m, saturating | ±32 768 N·m (8 samples ≤ ±330 N·m at the ADC's rails) | 1.5e-5 N·m |
+//! | drive torque sum | [`Q16`] N·m, saturating | 0 … 32 768 N·m (8 magnitudes ≤ 324 N·m at the ADC's rails) | 1.5e-5 N·m |
 //! | output travel sum | `i32` counts, saturating | ±2^31 counts (8 windows ≤ 2000 counts at the plausible speed) | 1 count |
 
 use super::config::Params;
@@ -68,7 +68,7 @@ pub(crate) struct DeadCurrent {
 
 /// Windows within which the pack must have been seen holding the output (standing still or
 /// thrown back within a window) for a block to be judged: 32 × 1.6 ms = 51 ms, most of a
-/// chatter cycle (60–75 ms in the twin).
+/// heavy chatter's cycle (≈ 60 ms in the twin: `monitor_chatter.rs`).
 pub(crate) const HOLD_MEMORY_WINDOWS: u8 = 32;
 
 /// Travel within a window (counts) that counts as the output standing still: one count of

@@ -122,8 +122,9 @@ pub struct Flags {
     /// Pack torque while driving beyond the allowance, drive current above the model, or a
     /// step up of the drive's work while driving (a drag that appears).
     pub brake_drag: bool,
-    /// Implausible encoder or current reading (jump, stuck counter, out-of-range code, or a
-    /// step down of the current-implied drive work: a current reading that lost gain).
+    /// Implausible encoder or current reading (jump, stuck counter, out-of-range code, a
+    /// step down of the current-implied drive work — a current reading that lost gain — or a
+    /// current reading dead while the drive moves the output).
     pub sensor_fault: bool,
     /// A tick was missed.
     pub overrun: bool,
