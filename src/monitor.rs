@@ -59,7 +59,7 @@
 //!
 //! # Cost
 //! `cargo xtask run --json` (Cortex-M3 under QEMU, the twin's reverse_load trace, release, LTO):
-//! mean 852.5, max 988 instructions per step (budget 1000; the worst step per scene is in the
+//! mean 852.4, max 988 instructions per step (budget 1000; the worst step per scene is in the
 //! command's `insns_per_step_max_by_scene`: 995 on the hold scene). The periodic parts (load
 //! filter or pack health, drive checks, friction energy, load-cache refresh, synchronism window,
 //! dead-current-reading check) each have their own tick, so that no step carries two of them

@@ -12,7 +12,7 @@
 //! 500 and 2026).
 
 use host_tests::accuracy::{compare, detection_latency_s, manifest_time, run_monitor};
-use host_tests::mc::{draw, draw_trace, Context, Draw, PRE_ROLL_S};
+use host_tests::mc::{draw, draw_trace, scene_after, Context, Draw, PRE_ROLL_S};
 use noback::monitor::Config;
 use noback_twin::fault::FaultKind;
 use noback_twin::model::Sample;
@@ -20,14 +20,7 @@ use noback_twin::model::Sample;
 /// The draw's scene as the Monte Carlo runs it (the twin started `PRE_ROLL_S` earlier),
 /// with or without its fault.
 fn twin_samples(d: &Draw, with_fault: bool) -> Result<Vec<Sample>, String> {
-    let mut scene = d.scene.clone();
-    scene.duration_s += PRE_ROLL_S;
-    if let Some(release) = scene.release_at_s.as_mut() {
-        *release += PRE_ROLL_S;
-    }
-    for f in &mut scene.faults {
-        f.at_s += PRE_ROLL_S;
-    }
+    let mut scene = scene_after(d, PRE_ROLL_S);
     if !with_fault {
         scene.faults.clear();
     }

@@ -233,10 +233,9 @@ pub fn draw_trace(d: &Draw) -> Result<Trace, String> {
     draw_trace_after(d, PRE_ROLL_S)
 }
 
-/// [`draw_trace`] with the monitor powered on `pre_roll_s` into the twin's run (0: at the
-/// scene's start, in the twin's own start-up transient, as the campaigns before the pre-roll
-/// did).
-pub fn draw_trace_after(d: &Draw, pre_roll_s: f64) -> Result<Trace, String> {
+/// The scene the twin runs for a draw whose monitor is powered on `pre_roll_s` into the run:
+/// longer by the pre-roll, its cut and fault onsets shifted by it (twin time).
+pub fn scene_after(d: &Draw, pre_roll_s: f64) -> Scene {
     let mut scene = d.scene.clone();
     scene.duration_s += pre_roll_s;
     if let Some(release) = scene.release_at_s.as_mut() {
@@ -245,7 +244,14 @@ pub fn draw_trace_after(d: &Draw, pre_roll_s: f64) -> Result<Trace, String> {
     for f in &mut scene.faults {
         f.at_s += pre_roll_s;
     }
-    let mut trace = scene_trace(&scene)?;
+    scene
+}
+
+/// [`draw_trace`] with the monitor powered on `pre_roll_s` into the twin's run (0: at the
+/// scene's start, in the twin's own start-up transient, as the campaigns before the pre-roll
+/// did).
+pub fn draw_trace_after(d: &Draw, pre_roll_s: f64) -> Result<Trace, String> {
+    let mut trace = scene_trace(&scene_after(d, pre_roll_s))?;
     let skip = (pre_roll_s * trace.sample_rate_hz).round() as usize;
     trace.rows.drain(..skip.min(trace.rows.len()));
     for r in &mut trace.rows {

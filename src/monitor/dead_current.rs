@@ -113,7 +113,7 @@ impl DeadCurrent {
     pub fn window(&mut self, drive: Q16, out_now: u32, p: &Params) -> bool {
         let travel = counter_delta(self.out, out_now, p.out_bits);
         self.out = out_now;
-        let thrown_back = (travel > 0 && self.dir < 0) || (travel < 0 && self.dir > 0);
+        let thrown_back = travel.signum() * self.dir < 0; // both in {−1, 0, 1}
         self.since_hold = if travel.saturating_abs() <= STILL_COUNTS || thrown_back {
             0
         } else {
