@@ -11,9 +11,11 @@
 //! modelled brake torque); correct with `e = y − θ̂`: `θ̂ += l₁e`, `ω̂ += l₂e`, `d̂ += J·l₃e`.
 //! Error dynamics `(I − LC)·A`, characteristic polynomial checked by the Jury test in `new`.
 
+use super::config::{Config, ConfigError};
+use super::convert::{finite, positive, scale, Q16_ONE};
 use super::scale::Scale;
 
-/// The observer's constants; see `Params::from_config` for their derivation.
+/// The observer's constants (derived in [`ObserverScales::new`]).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub(crate) struct ObserverScales {
     /// Q16 rad/s → angle words per tick (≈ 1.04 by default).
@@ -28,6 +30,51 @@ pub(crate) struct ObserverScales {
     pub l_v: Scale<36>,
     /// Angle words → Q16 N·m (J·l₃ ≈ 9.4e-3).
     pub l_d: Scale<33>,
+}
+
+impl ObserverScales {
+    /// Checks the gains' stability for every step count the observer may be advanced by
+    /// (1..=`max_catchup_ticks`, already checked) and converts them.
+    pub fn new(c: &Config) -> Result<ObserverScales, ConfigError> {
+        let h = 1.0 / c.tick_hz;
+        let j = positive(
+            c.mechanism.output_inertia_kg_m2,
+            "mechanism.output_inertia_kg_m2",
+        )?;
+        let g = c.observer;
+        finite(g.angle, "observer.angle")?;
+        finite(g.speed_per_s, "observer.speed_per_s")?;
+        finite(g.accel_per_s2, "observer.accel_per_s2")?;
+        for k in 1..=c.max_catchup_ticks {
+            if !g.is_stable(h * f64::from(k)) {
+                let parameter = if k == 1 {
+                    "observer"
+                } else {
+                    "max_catchup_ticks"
+                };
+                return Err(ConfigError::Unstable { parameter });
+            }
+        }
+        let words_per_rad = 4_294_967_296.0 / core::f64::consts::TAU;
+        let inertia = "mechanism.output_inertia_kg_m2";
+        Ok(ObserverScales {
+            // θ [word] += ω [Q16 bits] · h · words/rad / 2^16
+            theta_v: scale(h * words_per_rad / Q16_ONE, "tick_hz")?,
+            // θ += a·h²/2 with a = τ/J: τ [Q16 bits] → words
+            theta_a: scale(h * h / (2.0 * j) * words_per_rad / Q16_ONE, inertia)?,
+            // ω [Q16] += τ [Q16] · h/J
+            v_a: scale(h / j, inertia)?,
+            l_theta: scale(g.angle, "observer.angle")?,
+            l_v: scale(
+                g.speed_per_s / words_per_rad * Q16_ONE,
+                "observer.speed_per_s",
+            )?,
+            l_d: scale(
+                j * g.accel_per_s2 / words_per_rad * Q16_ONE,
+                "observer.accel_per_s2",
+            )?,
+        })
+    }
 }
 
 /// Observer state.
@@ -72,7 +119,7 @@ mod tests {
     extern crate std;
     use super::*;
     use crate::fx::Q16;
-    use crate::monitor::config::{Config, Params};
+    use crate::monitor::config::Config;
 
     /// The same observer in f64 with the constants the scales hold; the angle in radians.
     struct Reference {
@@ -83,8 +130,7 @@ mod tests {
 
     #[test]
     fn fixed_observer_follows_its_f64_reference() {
-        let params = Params::from_config(&Config::default()).unwrap_or_else(|_| unreachable!());
-        let k = params.obs;
+        let k = ObserverScales::new(&Config::default()).unwrap_or_else(|_| unreachable!());
         let word = core::f64::consts::TAU / 4_294_967_296.0; // rad per angle word
         let q = 1.0 / 65_536.0;
         let mut fx = Observer::default();

@@ -22,6 +22,8 @@
 //! | excursions | `i32` counts, saturating | ±2^31 counts | 1 count |
 
 use crate::fx::counter_delta;
+use crate::monitor::config::{Config, ConfigError};
+use crate::monitor::convert::counts;
 
 /// One shaft's monotone excursion: where the current run in one direction started and how far
 /// it has gone.
@@ -75,7 +77,7 @@ pub(crate) struct SlipCheck {
     motor: Excursion,
 }
 
-/// The check's limits, in counts (from [`super::config::Params`]).
+/// The check's limits, in counts (from the configuration).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub(crate) struct SlipLimits {
     /// Output travel of a common run beyond which the pack slips.
@@ -89,6 +91,50 @@ pub(crate) struct SlipLimits {
     /// Counter widths (bits), for the wrapping differences.
     pub out_bits: u8,
     pub motor_bits: u8,
+}
+
+impl SlipLimits {
+    pub fn new(c: &Config) -> Result<SlipLimits, ConfigError> {
+        let (s, t) = (&c.sensors, &c.thresholds);
+        let (out_rad, in_rad) = (s.output_rad_per_count(), s.input_rad_per_motor_count());
+        Ok(SlipLimits {
+            out_counts: within_quarter_counter(
+                counts(
+                    t.slip_output_travel_rad / out_rad,
+                    "thresholds.slip_output_travel_rad",
+                )?,
+                s.output_encoder_bits,
+                "thresholds.slip_output_travel_rad",
+            )?,
+            motor_counts: within_quarter_counter(
+                counts(
+                    t.slip_input_travel_rad / in_rad,
+                    "thresholds.slip_input_travel_rad",
+                )?,
+                s.motor_counter_bits,
+                "thresholds.slip_input_travel_rad",
+            )?,
+            out_hysteresis: counts(
+                t.slip_reversal_rad / out_rad,
+                "thresholds.slip_reversal_rad",
+            )?,
+            motor_hysteresis: counts(t.slip_reversal_rad / in_rad, "thresholds.slip_reversal_rad")?,
+            out_bits: s.output_encoder_bits,
+            motor_bits: s.motor_counter_bits,
+        })
+    }
+}
+
+/// A travel limit the check can measure on a wrapping counter: below a quarter of its range,
+/// so that the travel since the brake held (up to twice the limit) stays within the half range
+/// its wrapping difference resolves.
+fn within_quarter_counter(limit: i32, bits: u8, key: &'static str) -> Result<i32, ConfigError> {
+    let quarter = 1_i64 << (u32::from(bits.clamp(2, 32)) - 2);
+    if i64::from(limit) < quarter {
+        Ok(limit)
+    } else {
+        Err(ConfigError::OutOfRange { parameter: key })
+    }
 }
 
 impl SlipCheck {

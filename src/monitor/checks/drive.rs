@@ -14,9 +14,73 @@
 //! | implied load, its history | [`Q16`], saturating | ±32 768 N·m | 1.5e-5 N·m |
 //! | persistence counters | `u32` ticks, saturating | — | 1 tick |
 
-use super::config::Params;
-use super::{signed, Flags};
-use crate::fx::{lowpass, Q16};
+use crate::fx::{lowpass, Gain, Q16};
+use crate::monitor::config::{Config, ConfigError};
+use crate::monitor::convert::{filter_alpha, gain, nearest_shift, positive, q16, ticks};
+use crate::monitor::pack::{Dir, PackRatios, PackSettings};
+use crate::monitor::schedule::SLOW;
+use crate::monitor::Flags;
+
+/// The drive checks' constants.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) struct DriveSettings {
+    persistence_ticks: u32,
+    drive_drag: Q16,
+    max_load: Q16,
+    /// `T_drive + drag_allowance`: the pack torque above which a driving pack drags.
+    drag_limit: Q16,
+    /// Largest step of the implied load against its history while the drive carries the load.
+    pub step_limit: Q16,
+    /// The same step of drive torque while overrunning (`g₁ − 1` N·m of load per N·m).
+    pub step_limit_overrun: Q16,
+    /// The drive torque's own step that must come with a step of the implied load: half the
+    /// allowance.
+    step_drive_min: Q16,
+    /// The drive torque's history follows by this shift (the power of two nearest `step_alpha`).
+    drive_ref_shift: u32,
+    /// Gain of the implied load's history, in the slow lane.
+    step_alpha: Gain,
+}
+
+impl DriveSettings {
+    pub fn new(
+        c: &Config,
+        pack: &PackSettings,
+        r: &PackRatios,
+    ) -> Result<DriveSettings, ConfigError> {
+        let (t, tick_hz) = (&c.thresholds, c.tick_hz);
+        let allowance = positive(t.step_allowance_nm, "thresholds.step_allowance_nm")?;
+        let alpha = filter_alpha(
+            positive(t.step_reference_hz, "thresholds.step_reference_hz")?,
+            tick_hz,
+            SLOW,
+        );
+        Ok(DriveSettings {
+            persistence_ticks: ticks(
+                t.flag_persistence_s,
+                tick_hz,
+                "thresholds.flag_persistence_s",
+            )?,
+            drive_drag: pack.drive_drag,
+            max_load: q16(
+                positive(t.max_load_nm, "thresholds.max_load_nm")?,
+                "thresholds.max_load_nm",
+            )?,
+            drag_limit: q16(
+                r.drive_drag_nm + positive(t.drag_allowance_nm, "thresholds.drag_allowance_nm")?,
+                "thresholds.drag_allowance_nm",
+            )?,
+            step_limit: q16(allowance, "thresholds.step_allowance_nm")?,
+            step_limit_overrun: q16(
+                allowance * (2.0 * r.a_k / (r.a_k - 1.0) - 1.0),
+                "thresholds.step_allowance_nm",
+            )?,
+            step_drive_min: q16(allowance / 2.0, "thresholds.step_allowance_nm")?,
+            drive_ref_shift: nearest_shift(alpha),
+            step_alpha: gain(alpha, "thresholds.step_reference_hz")?,
+        })
+    }
+}
 
 /// State of the drive checks.
 #[derive(Clone, Copy, Debug, Default)]
@@ -42,7 +106,7 @@ pub(crate) struct DriveChecks {
 /// What the step knows of this tick.
 pub(crate) struct DriveTick {
     /// Direction of the output (±1: moving).
-    pub s: i32,
+    pub dir: Dir,
     /// Observer net torque `J_s·ω̇ − u` (N·m).
     pub net: Q16,
     /// Drive torque along the motion, from the current (N·m).
@@ -92,15 +156,16 @@ impl DriveChecks {
     /// the check and re-seed its history past the step; both faults it looks for can make the
     /// reading held impossible). At most the persistence time more.
     #[inline]
-    pub fn counting_step(&self, p: &Params) -> bool {
+    pub fn counting_step(&self, p: &DriveSettings) -> bool {
         let counting = 1..p.persistence_ticks;
         counting.contains(&self.step_down_ticks) || counting.contains(&self.step_up_ticks)
     }
 
     /// One run (one tick in four, `t.ticks` ticks since the last step, counted four times).
     #[inline(never)]
-    pub fn run(&mut self, flags: &mut Flags, p: &Params, t: &DriveTick) {
-        let counted = t.ticks.saturating_mul(4);
+    pub fn run(&mut self, p: &DriveSettings, t: &DriveTick) -> Flags {
+        let mut flags = Flags::default();
+        let counted = SLOW.covered(t.ticks);
         // Steps of the drive's work: the load the current implies (the observer's net torque
         // `J_s·ω̇ − u` with the pack model of the scene: drive drag, or the overrunning
         // equilibrium), along the motion, against its recent history (a low-pass at
@@ -116,7 +181,7 @@ impl DriveChecks {
         // reading it is seeded afresh once the new phase has settled (`engage_settle_s`, 20 ms,
         // when the caller runs the checks again): the observer needs no longer, since the
         // monitor hands the modelled pack torque's step to it bumplessly.
-        let along = signed(t.s, t.net.saturating_add(signed(t.s, t.pack)));
+        let along = t.dir.apply(t.net.saturating_add(t.dir.apply(t.pack)));
         if self.step_ref_valid {
             let dev = along.saturating_sub(self.step_ref);
             let (harder, lighter) = if t.engaged {
@@ -187,11 +252,11 @@ impl DriveChecks {
         // Drag against the drive's start: the load the current implies with a nominal drag
         // beyond the envelope, or the pack torque beyond the reference load by the allowance.
         if t.carrying && !t.pending {
-            let implied = t.net.saturating_add(signed(t.s, p.drive_drag)); // load if drag nominal
+            let implied = t.net.saturating_add(t.dir.apply(p.drive_drag)); // load if drag nominal
             let over_model = implied.saturating_abs() > p.max_load;
             let excess = t
                 .load_ref
-                .is_some_and(|r| signed(t.s, r.saturating_sub(t.net)) > p.drag_limit);
+                .is_some_and(|r| t.dir.apply(r.saturating_sub(t.net)) > p.drag_limit);
             self.drag_ticks = if over_model || excess {
                 self.drag_ticks.saturating_add(counted)
             } else {
@@ -203,6 +268,7 @@ impl DriveChecks {
         } else {
             self.drag_ticks = 0;
         }
+        flags
     }
 }
 
@@ -211,17 +277,21 @@ mod tests {
     use super::*;
     use crate::monitor::Config;
 
-    fn params() -> Params {
-        Params::from_config(&Config::default()).expect("default configuration")
+    fn settings() -> crate::monitor::settings::Settings {
+        crate::monitor::settings::Settings::new(&Config::default()).expect("default configuration")
+    }
+
+    fn params() -> DriveSettings {
+        settings().checks.drive
     }
 
     /// A steady drive carrying the load (the drive pushing `drive` N·m along the motion against
     /// a load the observer sees as the net torque `−drive + drag`), one run per call.
     fn carrying(drive: f64, pending: bool) -> DriveTick {
-        let p = params();
+        let p = settings().pack;
         let drive = Q16::from_num(drive);
         DriveTick {
-            s: 1,
+            dir: Dir::of(Q16::ONE, Q16::ZERO),
             net: drive.saturating_neg().saturating_add(p.drive_drag),
             drive,
             pack: p.drive_drag,
@@ -236,13 +306,11 @@ mod tests {
     /// Overrunning at a steady speed (`J·ω̇ = 0`, net `−u`): the pack at the equilibrium
     /// `y(u)`, the implied load along the motion `y(u) − u`.
     fn overrunning(drive: f64, pending: bool) -> DriveTick {
-        let p = params();
+        let p = settings().pack;
         let drive_q = Q16::from_num(drive);
         DriveTick {
             net: drive_q.saturating_neg(),
-            pack: Q16::from_bits(p.overrun_gain.apply(drive_q.to_bits()))
-                .saturating_sub(p.overrun_offset)
-                .max(Q16::ZERO),
+            pack: p.overrun_torque(drive_q),
             engaged: true,
             carrying: false,
             ..carrying(drive, pending)
@@ -254,7 +322,7 @@ mod tests {
         let p = params();
         let mut flags = Flags::default();
         for _ in 0..runs {
-            c.run(&mut flags, &p, t);
+            flags = flags.union(c.run(&p, t));
         }
         flags
     }

@@ -39,8 +39,46 @@
 //! | drive torque sum | [`Q16`] N·m, saturating | 0 … 32 768 N·m (8 magnitudes ≤ 324 N·m at the ADC's rails) | 1.5e-5 N·m |
 //! | output travel sum | `i32` counts, saturating | ±2^31 counts (8 windows ≤ 2000 counts at the plausible speed) | 1 count |
 
-use super::config::Params;
 use crate::fx::{counter_delta, Q16};
+use crate::monitor::config::{Config, ConfigError};
+use crate::monitor::convert::{counts, positive, q16, require};
+use crate::monitor::pack::PackRatios;
+use crate::monitor::schedule::WINDOW;
+
+/// The dead-reading check's constants.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) struct DeadCurrentSettings {
+    out_bits: u8,
+    /// `dead_current_nm` × the block's samples: the drive-torque sum below which a block
+    /// reads dead (N·m).
+    drive_sum: Q16,
+    /// `dead_current_speed_rad_s` as the output's travel summed over the block (counts).
+    travel_sum: i32,
+}
+
+impl DeadCurrentSettings {
+    pub fn new(c: &Config, r: &PackRatios) -> Result<DeadCurrentSettings, ConfigError> {
+        let t = &c.thresholds;
+        let block = f64::from(BLOCK_WINDOWS);
+        let dead = positive(t.dead_current_nm, "thresholds.dead_current_nm")?;
+        // Below the spring drag a moving no-back's drive always carries.
+        require(dead < r.drive_drag_nm, "thresholds.dead_current_nm")?;
+        let speed = positive(
+            t.dead_current_speed_rad_s,
+            "thresholds.dead_current_speed_rad_s",
+        )?;
+        Ok(DeadCurrentSettings {
+            out_bits: c.sensors.output_encoder_bits,
+            drive_sum: q16(dead * block, "thresholds.dead_current_nm")?,
+            travel_sum: counts(
+                speed * f64::from(WINDOW.ticks) * (1.0 / c.tick_hz)
+                    / c.sensors.output_rad_per_count()
+                    * block,
+                "thresholds.dead_current_speed_rad_s",
+            )?,
+        })
+    }
+}
 
 /// Synchronism windows per block: 8 × 16 ticks = 12.8 ms at 10 kHz, longer than the drive
 /// torque's passes through zero in overrunning chatter (≈ 10 ms), short enough that a dead
@@ -110,7 +148,7 @@ impl DeadCurrent {
     /// no drive torque at all — a brake failure, not a sensor's, and the output then never
     /// stands still. The caller adds the load condition.
     #[inline(never)]
-    pub fn window(&mut self, drive: Q16, out_now: u32, p: &Params) -> bool {
+    pub fn window(&mut self, drive: Q16, out_now: u32, p: &DeadCurrentSettings) -> bool {
         let travel = counter_delta(self.out, out_now, p.out_bits);
         self.out = out_now;
         let thrown_back = travel.signum() * self.dir < 0; // both in {−1, 0, 1}
@@ -130,8 +168,8 @@ impl DeadCurrent {
         }
         let dead = self.armed
             && self.since_hold < HOLD_MEMORY_WINDOWS
-            && self.drive_sum < p.dead_drive_sum
-            && self.travel_sum > p.dead_travel_sum;
+            && self.drive_sum < p.drive_sum
+            && self.travel_sum > p.travel_sum;
         self.drive_sum = Q16::ZERO;
         self.travel_sum = 0;
         self.windows = 0;
@@ -145,8 +183,10 @@ mod tests {
     use super::*;
     use crate::monitor::Config;
 
-    fn params() -> Params {
-        match Params::from_config(&Config::default()) {
+    fn params() -> DeadCurrentSettings {
+        match crate::monitor::settings::Settings::new(&Config::default())
+            .map(|s| s.checks.dead_current)
+        {
             Ok(p) => p,
             Err(e) => panic!("defaults: {e:?}"),
         }
@@ -159,7 +199,7 @@ mod tests {
     struct Check {
         d: DeadCurrent,
         out: u32,
-        p: Params,
+        p: DeadCurrentSettings,
     }
 
     impl Check {

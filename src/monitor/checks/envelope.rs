@@ -1,0 +1,187 @@
+//! The braking envelope (`brake_weak`): from the drive's cut, a nominal braking model —
+//! speed decreasing at `(T_all ∓ |M̂|)/J_s`, both socket faces clamping — stepped by explicit
+//! Euler in I16F16 at `braking_model_hz`, gives the speed and angle a working pack allows; the
+//! output may overrun them by the allowances. A pack that does not brake at all is caught
+//! sooner: the output going further than it would at its cut speed, undecelerated.
+//!
+//! | quantity | format | range | resolution |
+//! |---|---|---|---|
+//! | travel, expected travel | `i32` Q16 output counts, saturating (compared in `i64`) | ±2^15 counts | 2^-16 count |
+//! | expected speed | [`Q16`] rad/s | 0 … 32 768 | 1.5e-5 rad/s |
+
+use crate::fx::Q16;
+use crate::monitor::config::{Config, ConfigError};
+use crate::monitor::convert::{counts, positive, scale, ticks, Q16_ONE};
+use crate::monitor::pack::Dir;
+use crate::monitor::scale::Scale;
+use crate::monitor::schedule::Slot;
+use crate::monitor::sense::times;
+
+/// The envelope's constants.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) struct EnvelopeSettings {
+    /// Ticks per step of the nominal braking model (`tick_hz / braking_model_hz`).
+    pub model_ticks: u32,
+    /// The model's rate (Hz, rounded).
+    pub model_hz: u32,
+    /// One model step: Q16 rad/s → Q16 output counts travelled.
+    travel: Scale<20>,
+    /// One model step: Q16 N·m → Q16 rad/s of speed change.
+    speed: Scale<30>,
+    /// Q16 rad/s → Q16 output counts per tick.
+    speed_to_counts: Scale<28>,
+    /// Q16 N·m → Q16 rad/s per tick (`h/J_s`).
+    decel_per_tick: Scale<37>,
+    grace_ticks: u32,
+    angle_factor: Scale<25>,
+    /// Q16 output counts.
+    angle_allowance: i32,
+    /// Q16 output counts.
+    undecelerated_allowance: i32,
+}
+
+impl EnvelopeSettings {
+    pub fn new(c: &Config) -> Result<EnvelopeSettings, ConfigError> {
+        let (t, tick_hz) = (&c.thresholds, c.tick_hz);
+        let h = 1.0 / tick_hz;
+        let j = positive(
+            c.mechanism.output_inertia_kg_m2,
+            "mechanism.output_inertia_kg_m2",
+        )?;
+        let out_rad = c.sensors.output_rad_per_count();
+        let model_ticks = model_ticks(c.braking_model_hz, tick_hz)?;
+        let per_step = f64::from(model_ticks);
+        let q16_counts = |rad: f64, key| counts(positive(rad, key)? / out_rad * Q16_ONE, key);
+        Ok(EnvelopeSettings {
+            model_ticks,
+            // 100 Hz ≤ tick_hz ≤ 1 MHz and ticks ≥ 1: the rate fits a u32.
+            model_hz: (tick_hz / per_step + 0.5) as u32,
+            travel: scale(h / out_rad * per_step, "braking_model_hz")?,
+            speed: scale(h / j * per_step, "braking_model_hz")?,
+            speed_to_counts: scale(h / out_rad, "sensors.output_encoder_bits")?,
+            decel_per_tick: scale(h / j, "mechanism.output_inertia_kg_m2")?,
+            grace_ticks: ticks(t.braking_grace_s, tick_hz, "thresholds.braking_grace_s")?,
+            angle_factor: scale(
+                positive(t.braking_angle_factor, "thresholds.braking_angle_factor")?,
+                "thresholds.braking_angle_factor",
+            )?,
+            angle_allowance: q16_counts(
+                t.braking_angle_allowance_rad,
+                "thresholds.braking_angle_allowance_rad",
+            )?,
+            undecelerated_allowance: q16_counts(
+                t.undecelerated_allowance_rad,
+                "thresholds.undecelerated_allowance_rad",
+            )?,
+        })
+    }
+}
+
+/// Ticks per step of the braking model: a whole number from 1 to 1000 (the model may not run
+/// faster than the ticks, and at 1/1000 of them it would not see a braking event at all).
+fn model_ticks(model_hz: f64, tick_hz: f64) -> Result<u32, ConfigError> {
+    const KEY: &str = "braking_model_hz";
+    let ratio = tick_hz / positive(model_hz, KEY)?;
+    let whole = (ratio + 0.5) as u32; // 0 < ratio ≤ 1e10: `as` saturates, never wraps
+    if !(1..=1000).contains(&whole) || (ratio - f64::from(whole)).abs() > 1e-9 * ratio {
+        return Err(ConfigError::OutOfRange { parameter: KEY });
+    }
+    Ok(whole)
+}
+
+/// One braking event's envelope (drive cut to lock).
+#[derive(Clone, Copy, Debug, Default)]
+pub(crate) struct Envelope {
+    /// Output travel since the cut (counts, saturating).
+    counts: i32,
+    expected_speed: Q16,
+    /// Q16 counts, saturating.
+    expected_counts: i32,
+    /// Ticks moving after the nominal model stopped.
+    overdue_ticks: u32,
+    /// Ticks since the model's last step.
+    model_ticks: u32,
+    /// Travel per tick and per usual model step at the cut speed (Q16 counts).
+    free_tick: i32,
+    free_step: i32,
+    /// Travel at the cut speed, undecelerated, since the cut (Q16 counts, saturating).
+    free_counts: i32,
+}
+
+/// What one envelope call reads.
+pub(crate) struct BrakingTick {
+    pub n: u32,
+    pub tick: u32,
+    pub d_out: i32,
+    pub dir: Dir,
+    pub load_dir: Dir,
+    pub load_abs: Q16,
+    pub capacity: Q16,
+}
+
+impl Envelope {
+    /// Starts from the present output speed.
+    pub fn arm(&mut self, k: &EnvelopeSettings, speed: Q16) {
+        let speed = speed.saturating_abs();
+        let free_tick = k.speed_to_counts.apply(speed.to_bits());
+        *self = Envelope {
+            expected_speed: speed,
+            free_tick,
+            free_step: times(free_tick, i32::try_from(k.model_ticks).unwrap_or(i32::MAX)),
+            ..Envelope::default()
+        };
+    }
+
+    /// One braking call; returns whether the output left the envelope.
+    pub fn check(&mut self, k: &EnvelopeSettings, b: &BrakingTick) -> bool {
+        let mut weak = false;
+        self.model_ticks = self.model_ticks.saturating_add(b.n);
+        self.counts = self.counts.saturating_add(b.d_out.saturating_abs());
+        if self.model_ticks >= k.model_ticks && Slot::braking_model_may_step(b.tick) {
+            weak |= self.model_step(k, b);
+        }
+        if self.expected_speed == Q16::ZERO {
+            self.overdue_ticks = self.overdue_ticks.saturating_add(b.n);
+        }
+        // Both sides < 2^47: exact in i64.
+        let angle_limit =
+            i64::from(k.angle_factor.apply(self.expected_counts)) + i64::from(k.angle_allowance);
+        weak || self.overdue_ticks > k.grace_ticks || i64::from(self.counts) << 16 > angle_limit
+    }
+
+    /// One explicit-Euler step over the ticks it covers: travel with the old speed, then the
+    /// speed. Returns whether the pack is not braking at all.
+    fn model_step(&mut self, k: &EnvelopeSettings, b: &BrakingTick) -> bool {
+        let decel = if b.dir == b.load_dir {
+            b.capacity.saturating_sub(b.load_abs)
+        } else {
+            b.capacity.saturating_add(b.load_abs)
+        }
+        .max(Q16::ZERO);
+        // The usual step's constants are precomputed; a longer one (a late tick, or the first
+        // step after an arm on an even tick) multiplies the per-tick ones.
+        let (travel, dv, free) = if self.model_ticks == k.model_ticks {
+            (
+                k.travel.apply(self.expected_speed.to_bits()),
+                k.speed.apply(decel.to_bits()),
+                self.free_step,
+            )
+        } else {
+            // ≤ 1000 + 256 ticks (reset at each model step): fits an i32.
+            let n = i32::try_from(self.model_ticks).unwrap_or(i32::MAX);
+            (
+                times(k.speed_to_counts.apply(self.expected_speed.to_bits()), n),
+                times(k.decel_per_tick.apply(decel.to_bits()), n),
+                times(self.free_tick, n),
+            )
+        };
+        self.model_ticks = 0;
+        self.expected_counts = self.expected_counts.saturating_add(travel);
+        self.expected_speed =
+            Q16::from_bits(self.expected_speed.to_bits().saturating_sub(dv).max(0));
+        self.free_counts = self.free_counts.saturating_add(free);
+        // Both sides < 2^48: exact in i64.
+        i64::from(self.counts) << 16
+            > i64::from(self.free_counts) + i64::from(k.undecelerated_allowance)
+    }
+}

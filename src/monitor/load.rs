@@ -1,0 +1,206 @@
+//! The load and the pack's health: the load learned where it is well conditioned (driving,
+//! where the pack torque follows from the current alone) and held elsewhere; the capacity and
+//! margin that follow from it; the pack health learned while the pack slips with the drive off.
+//!
+//! | quantity | format | range | resolution |
+//! |---|---|---|---|
+//! | load, capacity, available | [`Q16`] N·m, saturating | ±32 768 | 1.5e-5 N·m |
+//! | margin | [`Q16`], at most [`MARGIN_MAX`] | 0 … 1000 | 1.5e-5 |
+//! | health | [`Q16`], clamped | 0 … 2 | 1.5e-5 |
+
+use super::config::{Config, ConfigError};
+use super::convert::{filter_gain, positive, scale, ticks, Q16_ONE};
+use super::scale::{recip_q16, Scale};
+use super::schedule::SLOW;
+use super::{mul_q16, MARGIN_MAX};
+use crate::fx::{lowpass, Gain, Q16};
+
+/// Pack health is kept within [0, 2].
+const HEALTH_MAX: i32 = 2 << 16;
+
+/// The load stage's constants.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) struct LoadSettings {
+    /// Gain of the load filter, run in the slow lane.
+    alpha: Gain,
+    /// Learning ticks before the load counts as known (three time constants).
+    known_ticks: u32,
+    min_margin: Scale<26>,
+    /// Health change per slow-lane update (Q16 bits).
+    health_step: i32,
+}
+
+impl LoadSettings {
+    pub fn new(c: &Config) -> Result<LoadSettings, ConfigError> {
+        let (t, tick_hz) = (&c.thresholds, c.tick_hz);
+        let hz = positive(t.load_filter_hz, "thresholds.load_filter_hz")?;
+        let health_step = positive(t.health_rate_per_s, "thresholds.health_rate_per_s")?
+            * f64::from(SLOW.ticks)
+            * (1.0 / tick_hz);
+        super::convert::require(health_step < 0.5, "thresholds.health_rate_per_s")?;
+        Ok(LoadSettings {
+            alpha: filter_gain(hz, tick_hz, SLOW, "thresholds.load_filter_hz")?,
+            known_ticks: ticks(
+                3.0 / (core::f64::consts::TAU * hz),
+                tick_hz,
+                "thresholds.load_filter_hz",
+            )?,
+            min_margin: scale(
+                positive(t.min_capacity_margin, "thresholds.min_capacity_margin")?,
+                "thresholds.min_capacity_margin",
+            )?,
+            health_step: ((health_step * Q16_ONE + 0.5) as i32).max(1),
+        })
+    }
+}
+
+/// The load estimate: learning (from zero at power-on) until the filter has run three time
+/// constants, then known; held with the drive off.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) enum LoadEstimate {
+    Learning(Q16),
+    Known(Q16),
+}
+
+impl LoadEstimate {
+    #[inline]
+    pub fn value(self) -> Q16 {
+        match self {
+            LoadEstimate::Learning(x) | LoadEstimate::Known(x) => x,
+        }
+    }
+
+    #[inline]
+    pub fn known(self) -> Option<Q16> {
+        match self {
+            LoadEstimate::Known(x) => Some(x),
+            LoadEstimate::Learning(_) => None,
+        }
+    }
+}
+
+/// Capacity, reciprocal and margin floor for one load value, recomputed when it changes;
+/// `available` and `margin` for one health value.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct LoadCache {
+    load: Q16,
+    valid: bool,
+    /// Static capacity `μ_s·c·(F_s + k·|M̂|)` of the pack clamped by the load (drive off).
+    pub capacity: Q16,
+    recip: Q16,
+    /// `min_capacity_margin · |M̂|`.
+    pub margin_floor: Q16,
+    health: Q16,
+    /// `health · capacity`.
+    pub available: Q16,
+    /// `available / |M̂|`, at most [`MARGIN_MAX`].
+    pub margin: Q16,
+}
+
+/// The load stage's state.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Load {
+    pub estimate: LoadEstimate,
+    learn_ticks: u32,
+    /// The known load at the drive's start (the drag check's reference).
+    pub reference: Option<Q16>,
+    pub health: Q16,
+    pub cache: LoadCache,
+}
+
+impl Load {
+    pub const fn new() -> Load {
+        Load {
+            estimate: LoadEstimate::Learning(Q16::ZERO),
+            learn_ticks: 0,
+            reference: None,
+            health: Q16::ONE,
+            cache: LoadCache {
+                load: Q16::ZERO,
+                valid: false,
+                capacity: Q16::ZERO,
+                recip: Q16::ZERO,
+                margin_floor: Q16::ZERO,
+                health: Q16::ONE,
+                available: Q16::ZERO,
+                margin: Q16::ZERO,
+            },
+        }
+    }
+
+    /// At the drive's start the known load becomes the drag check's reference.
+    pub fn drive_started(&mut self) {
+        self.reference = self.estimate.known();
+    }
+
+    /// One slow-lane learning step with the load this call implies (`n` ticks elapsed).
+    pub fn learn(&mut self, k: &LoadSettings, implied: Q16, n: u32) {
+        let value = lowpass(self.estimate.value(), implied, k.alpha);
+        self.learn_ticks = self.learn_ticks.saturating_add(SLOW.covered(n));
+        self.estimate = match self.estimate {
+            LoadEstimate::Learning(_) if self.learn_ticks >= k.known_ticks => {
+                // First known load of a drive that started without one (power-on while
+                // driving): the drag check's reference from here on.
+                if self.reference.is_none() {
+                    self.reference = Some(value);
+                }
+                LoadEstimate::Known(value)
+            }
+            LoadEstimate::Learning(_) => LoadEstimate::Learning(value),
+            LoadEstimate::Known(_) => LoadEstimate::Known(value),
+        };
+    }
+
+    /// Refreshes the cache for the present load (`capacity_of`: capacity at a load).
+    pub fn refresh(&mut self, k: &LoadSettings, capacity: Q16) {
+        let load_abs = self.estimate.value().saturating_abs();
+        self.cache = LoadCache {
+            load: self.estimate.value(),
+            valid: true,
+            capacity,
+            recip: Q16::from_bits(recip_q16(load_abs.to_bits())),
+            margin_floor: Q16::from_bits(k.min_margin.apply(load_abs.to_bits())),
+            health: self.health,
+            available: Q16::ZERO,
+            margin: Q16::ZERO,
+        };
+        self.cache_health();
+    }
+
+    /// Whether the cache lags the load (or was never formed).
+    pub fn cache_stale(&self) -> bool {
+        self.cache.load != self.estimate.value()
+    }
+
+    pub fn cache_valid(&self) -> bool {
+        self.cache.valid
+    }
+
+    /// One slow-lane health step (sign-LMS, no division): the measured braking torque along
+    /// the motion against the healthy pack's.
+    pub fn learn_health(&mut self, k: &LoadSettings, measured_along: Q16) {
+        let predicted = mul_q16(self.health, self.cache.capacity);
+        let step = if measured_along > predicted {
+            k.health_step
+        } else {
+            -k.health_step
+        };
+        self.health = Q16::from_bits(
+            self.health
+                .to_bits()
+                .saturating_add(step)
+                .clamp(0, HEALTH_MAX),
+        );
+        if self.cache.health != self.health {
+            self.cache_health();
+        }
+    }
+
+    /// `available` and `margin` for the present health (two products).
+    fn cache_health(&mut self) {
+        let c = &mut self.cache;
+        c.health = self.health;
+        c.available = mul_q16(self.health, c.capacity);
+        c.margin = mul_q16(c.available, c.recip).min(MARGIN_MAX);
+    }
+}

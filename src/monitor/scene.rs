@@ -1,0 +1,338 @@
+//! Classifying: which scene the actuator is in, as one state machine, and with it the output's
+//! direction, the drive torque along the motion and the overrunning equilibrium.
+//!
+//! | state | when | leaves |
+//! |---|---|---|
+//! | `Driving(reading)` | drive on | drive off → `Braking` |
+//! | `Braking` | drive off, output moving | stopped 1 ms or thrown back → `Holding`; drive on |
+//! | `Holding` | drive off, the pack holds | a slip check → `Braking`; drive on |
+//!
+//! While driving, the *reading* says who carries the load: the drive (`Driving` scene: pack at
+//! its drag) or the pack (`Overrunning`: the load runs along the motion). The current tells
+//! them apart only when the overrunning reading's load lies outside the envelope; otherwise the
+//! learned load's sign decides, and with no load known yet the overrunning reading is taken.
+//! After the first settled decision of a drive, the other reading must be wanted for
+//! `engage_settle_s` (and the step check must not be counting) before it switches.
+
+use super::config::{Config, ConfigError};
+use super::convert::{counts, positive, q16, ticks};
+use super::load::LoadEstimate;
+use super::observe::Observed;
+use super::pack::{Dir, PackSettings};
+use super::scale::Scale;
+use super::schedule::{Slot, WINDOW};
+use super::sense::Sensed;
+use super::{convert::scale, Scene};
+use crate::fx::{counter_delta, Q16};
+
+/// The classifier's constants.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) struct SceneSettings {
+    pub stick_speed: Q16,
+    pub min_load: Q16,
+    pub max_load: Q16,
+    lock_dwell_ticks: u32,
+    pub engage_settle_ticks: u32,
+    settle_ticks: u32,
+    out_bits: u8,
+    motor_bits: u8,
+    /// Motor counts → output counts (the shafts turn alike when synchronous).
+    motor_to_out: Scale<30>,
+    /// Relative travel (output counts) over a window within the synchronism band.
+    sync_band_counts: i32,
+}
+
+impl SceneSettings {
+    pub fn new(c: &Config, settle_ticks: u32) -> Result<SceneSettings, ConfigError> {
+        let (s, t, tick_hz) = (&c.sensors, &c.thresholds, c.tick_hz);
+        let (out_rad, in_rad) = (s.output_rad_per_count(), s.input_rad_per_motor_count());
+        Ok(SceneSettings {
+            stick_speed: q16(
+                positive(t.stick_speed_rad_s, "thresholds.stick_speed_rad_s")?,
+                "thresholds.stick_speed_rad_s",
+            )?,
+            min_load: q16(
+                positive(t.min_load_nm, "thresholds.min_load_nm")?,
+                "thresholds.min_load_nm",
+            )?,
+            max_load: q16(
+                positive(t.max_load_nm, "thresholds.max_load_nm")?,
+                "thresholds.max_load_nm",
+            )?,
+            lock_dwell_ticks: ticks(t.lock_dwell_s, tick_hz, "thresholds.lock_dwell_s")?,
+            engage_settle_ticks: ticks(t.engage_settle_s, tick_hz, "thresholds.engage_settle_s")?,
+            settle_ticks,
+            out_bits: s.output_encoder_bits,
+            motor_bits: s.motor_counter_bits,
+            motor_to_out: scale(in_rad / out_rad, "sensors.motor_encoder_counts_per_rev")?,
+            sync_band_counts: counts(
+                t.sync_speed_band_rad_s * f64::from(WINDOW.ticks) * (1.0 / tick_hz) / out_rad,
+                "thresholds.sync_speed_band_rad_s",
+            )?,
+        })
+    }
+}
+
+/// Who carries the load while the drive runs.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) struct Reading {
+    pub overrunning: bool,
+    /// Decided once this drive, on a settled observer.
+    decided: bool,
+    /// Ticks the other reading has been wanted.
+    pending_ticks: u32,
+}
+
+/// The scene state machine.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) enum Phase {
+    Driving(Reading),
+    Braking,
+    Holding,
+}
+
+/// What classifying hands on.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Classified {
+    pub scene: Scene,
+    /// Output direction (outside the stick band).
+    pub dir: Dir,
+    /// Drive torque along the motion.
+    pub along: Q16,
+    /// Overrunning equilibrium `y` (computed only where it is needed, else zero).
+    pub overrun_torque: Q16,
+    /// A change of driving reading is pending.
+    pub pending: bool,
+    /// The reading changed this call (bumpless for the observer).
+    pub reading_switch: bool,
+    /// The brake locked this call.
+    pub just_locked: bool,
+    /// The scene has lasted `engage_settle_s`.
+    pub phase_settled: bool,
+    /// The drive has run steadily (output with the input) for `engage_settle_s` / the
+    /// observer's settling time.
+    pub steady_for_learning: bool,
+    pub steady_for_checks: bool,
+}
+
+impl Classified {
+    /// Ramps engaged: the drive off (both socket faces clamp) or overrunning.
+    #[inline]
+    pub fn engaged(&self) -> bool {
+        self.scene != Scene::Driving
+    }
+}
+
+/// The classifier's state.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Classify {
+    pub phase: Phase,
+    scene: Scene,
+    stick_ticks: u32,
+    phase_ticks: u32,
+    last_dir: Dir,
+    /// Ticks of steady driving, counted in windows on the synchronism slot.
+    steady_ticks: u32,
+    sync_out: u32,
+    sync_motor: u32,
+}
+
+impl Classify {
+    pub const fn new() -> Classify {
+        Classify {
+            phase: Phase::Braking,
+            scene: Scene::FaultBraking,
+            stick_ticks: 0,
+            phase_ticks: 0,
+            last_dir: Dir::NONE,
+            steady_ticks: 0,
+            sync_out: 0,
+            sync_motor: 0,
+        }
+    }
+
+    /// The previous call's scene.
+    pub fn scene(&self) -> Scene {
+        self.scene
+    }
+
+    #[allow(clippy::too_many_arguments)]
+    pub fn update(
+        &mut self,
+        k: &SceneSettings,
+        pack: &PackSettings,
+        x: &Sensed,
+        o: &Observed,
+        load: LoadEstimate,
+        step_counting: bool,
+        slot: Slot,
+    ) -> Classified {
+        let n = x.n;
+        if x.first {
+            (self.sync_out, self.sync_motor) = (x.out, x.motor);
+        }
+        if x.drive && o.head_start > 0 {
+            self.steady_ticks = self.steady_ticks.saturating_add(o.head_start);
+        }
+        if x.drive_edge {
+            self.steady_ticks = 0;
+        }
+        let dir = Dir::of(o.w, k.stick_speed);
+        let along = dir.apply(o.drive_torque);
+        let known = load.known().is_some();
+        let load_along = dir.apply(load.value()) > k.min_load;
+        // y is needed while overrunning, or to test for it unless a known load is against the
+        // motion (then the reading is settled and the product is skipped).
+        let mut overrun_torque = Q16::ZERO;
+        let mut just_locked = false;
+        let prev = self.phase;
+        self.phase = match (x.drive, prev) {
+            (true, _) if dir.is_none() => Phase::Driving(Reading::none()),
+            (true, p) => {
+                let r = match p {
+                    Phase::Driving(r) => r,
+                    _ => Reading::none(),
+                };
+                if r.overrunning || !known || load_along {
+                    overrun_torque = pack.overrun_torque(along);
+                }
+                let implied = overrun_torque.saturating_sub(along);
+                let possible = o.settled
+                    && along > pack.drive_drag
+                    && implied > k.min_load
+                    && implied <= k.max_load;
+                let wanted = possible && (!known || load_along);
+                Phase::Driving(r.next(wanted, o.settled, n, k.engage_settle_ticks, step_counting))
+            }
+            (false, p) => {
+                self.stick_ticks = if o.w.saturating_abs() < k.stick_speed {
+                    self.stick_ticks.saturating_add(n)
+                } else {
+                    0
+                };
+                // The brake stops the output: it dwells in the stick band, or an impact in the
+                // lost motion throws it back within a tick or two.
+                let reversed = dir.opposes(self.last_dir);
+                match p {
+                    Phase::Holding => Phase::Holding,
+                    _ if self.stick_ticks >= k.lock_dwell_ticks || reversed => {
+                        just_locked = true;
+                        Phase::Holding
+                    }
+                    _ => Phase::Braking,
+                }
+            }
+        };
+        if x.drive {
+            self.stick_ticks = 0;
+        }
+        if !dir.is_none() {
+            self.last_dir = dir;
+        }
+        let scene = match self.phase {
+            Phase::Driving(r) if r.overrunning => Scene::Overrunning,
+            Phase::Driving(_) => Scene::Driving,
+            Phase::Braking => Scene::FaultBraking,
+            Phase::Holding => Scene::Holding,
+        };
+        // A change between the two driving readings changes how the motion is read, not it.
+        let reading_switch = x.drive
+            && matches!(self.scene, Scene::Driving | Scene::Overrunning)
+            && scene != self.scene;
+        self.phase_ticks = if scene != self.scene {
+            0
+        } else {
+            self.phase_ticks.saturating_add(n)
+        };
+        self.scene = scene;
+        let steady_for_learning = self.steady_ticks >= k.engage_settle_ticks;
+        let steady_for_checks = self.steady_ticks >= k.settle_ticks;
+        if x.drive && slot == Slot::Sync {
+            self.sync_window(k, x, dir);
+        }
+        Classified {
+            scene,
+            dir,
+            along,
+            overrun_torque,
+            pending: matches!(self.phase, Phase::Driving(r) if r.pending_ticks != 0),
+            reading_switch,
+            just_locked,
+            phase_settled: self.phase_ticks >= k.engage_settle_ticks,
+            steady_for_learning,
+            steady_for_checks,
+        }
+    }
+
+    /// A slip check saw the pack give way: the brake no longer holds.
+    pub fn lose_hold(&mut self) {
+        if self.phase == Phase::Holding {
+            self.phase = Phase::Braking;
+        }
+    }
+
+    /// Whether the brake is locked (holding).
+    pub fn locked(&self) -> bool {
+        self.phase == Phase::Holding
+    }
+
+    /// Steady driving: the travel of both shafts over the last window agrees within the band
+    /// (measured on the counters, not the observer, whose speed lags a step of the model's
+    /// torque). An output that runs away from the input restarts the count.
+    fn sync_window(&mut self, k: &SceneSettings, x: &Sensed, dir: Dir) {
+        let d_o = counter_delta(self.sync_out, x.out, k.out_bits);
+        let d_m = counter_delta(self.sync_motor, x.motor, k.motor_bits);
+        (self.sync_out, self.sync_motor) = (x.out, x.motor);
+        let synchronous = k
+            .motor_to_out
+            .apply(d_m)
+            .saturating_sub(d_o)
+            .saturating_abs()
+            <= k.sync_band_counts;
+        self.steady_ticks = if !dir.is_none() && synchronous {
+            self.steady_ticks
+                .saturating_add(x.n.saturating_mul(WINDOW.ticks))
+        } else {
+            0
+        };
+    }
+}
+
+impl Reading {
+    const fn none() -> Reading {
+        Reading {
+            overrunning: false,
+            decided: false,
+            pending_ticks: 0,
+        }
+    }
+
+    /// Debounced: the first settled decision of a drive is taken at once; a later change only
+    /// once wanted for `settle` ticks and not while the step check counts towards a verdict.
+    fn next(
+        self,
+        wanted: bool,
+        settled: bool,
+        n: u32,
+        settle: u32,
+        step_counting: bool,
+    ) -> Reading {
+        let mut r = self;
+        if settled && !r.decided {
+            r = Reading {
+                overrunning: wanted,
+                decided: true,
+                pending_ticks: 0,
+            };
+        } else if wanted == r.overrunning {
+            r.pending_ticks = 0;
+        } else {
+            r.pending_ticks = r.pending_ticks.saturating_add(n);
+            if r.pending_ticks >= settle && !step_counting {
+                r.overrunning = wanted;
+                r.pending_ticks = 0;
+            }
+        }
+        r
+    }
+}

@@ -1,0 +1,346 @@
+//! Sensing: raw ADC code and counters into currents, counts and the output's angle word, with
+//! their plausibility (`sensor_fault`), the input shaft's speed and the output's position
+//! history (the holding estimate's impacts).
+//!
+//! | quantity | format | range | resolution |
+//! |---|---|---|---|
+//! | current | `i32` ADC counts about mid-scale | ±2^15 | 1 count |
+//! | counter deltas | `i32` counts, wrapping difference | ±half the counter | 1 count |
+//! | angle word | `u32`, wrapping | one turn | 2π/2³² rad |
+//! | input speed | [`Q16`] rad/s, saturating | ±32 768 | 1.5e-5 rad/s |
+//! | position history | `i16` counts mod 2^16, wrapping | differences over ≤ 63 ticks | 1 count |
+
+use super::config::{Config, ConfigError};
+use super::convert::{counts, filter_gain, positive, require, scale, ticks, Q16_ENVELOPE, Q16_ONE};
+use super::scale::Scale;
+use super::schedule::Lane;
+use super::Inputs;
+use crate::fx::{adc_centered, counter_delta, lowpass, Gain, Q16};
+
+/// Ticks of output-position history: a power of two above twice the longest impact window.
+const POSITION_HISTORY: usize = 64;
+
+/// The sensors' constants.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) struct SenseSettings {
+    adc_bits: u8,
+    adc_max_code: u16,
+    adc_rail_ticks: u32,
+    current_off_counts: i32,
+    pub out_bits: u8,
+    out_mask: u32,
+    out_shift: u32,
+    /// Largest plausible output step in one tick (counts).
+    pub out_jump_counts: i32,
+    pub motor_bits: u8,
+    motor_mask: u32,
+    motor_jump_counts: i32,
+    lost_motor_counts: u32,
+    lost_out_counts: u32,
+    input_speed: Scale<11>,
+    input_alpha: Gain,
+    /// Ticks `m` of the impact's second difference (1..=31).
+    impact_window: u8,
+    /// Second difference of the output position (counts) → Q16 N·m: `J_s·Δθ/(m·h)²`.
+    impact_torque: Scale<8>,
+}
+
+impl SenseSettings {
+    pub fn new(c: &Config) -> Result<SenseSettings, ConfigError> {
+        let (s, t, tick_hz) = (&c.sensors, &c.thresholds, c.tick_hz);
+        let h = 1.0 / tick_hz;
+        let ratio = positive(s.reducer_ratio, "sensors.reducer_ratio")?;
+        require(
+            (4..=16).contains(&s.current_adc_bits),
+            "sensors.current_adc_bits",
+        )?;
+        positive(s.current_full_scale_a, "sensors.current_full_scale_a")?;
+        require(
+            (8..=24).contains(&s.output_encoder_bits),
+            "sensors.output_encoder_bits",
+        )?;
+        require(
+            (8..=32).contains(&s.motor_counter_bits),
+            "sensors.motor_counter_bits",
+        )?;
+        require(
+            s.motor_encoder_counts_per_rev != 0,
+            "sensors.motor_encoder_counts_per_rev",
+        )?;
+        require((1..=32).contains(&c.max_catchup_ticks), "max_catchup_ticks")?;
+        let (out_rad, in_rad) = (s.output_rad_per_count(), s.input_rad_per_motor_count());
+        let max_out = positive(
+            t.max_output_speed_rad_s,
+            "thresholds.max_output_speed_rad_s",
+        )?;
+        let max_motor = positive(t.max_motor_speed_rad_s, "thresholds.max_motor_speed_rad_s")?;
+        if max_out > Q16_ENVELOPE || max_motor / ratio > Q16_ENVELOPE {
+            return Err(ConfigError::Overflow {
+                parameter: "thresholds.max_output_speed_rad_s",
+            });
+        }
+        // A late step may cover `max_catchup_ticks` and must stay within half a counter period,
+        // or `counter_delta` would alias.
+        let catchup = f64::from(c.max_catchup_ticks);
+        let out_jump = max_out * h / out_rad + 1.0;
+        let motor_jump = max_motor * h / (in_rad * ratio) + 1.0;
+        if out_jump * catchup >= f64::from(1_u32 << (s.output_encoder_bits - 1)) {
+            return Err(ConfigError::Overflow {
+                parameter: "sensors.output_encoder_bits",
+            });
+        }
+        if motor_jump * catchup >= f64::from(1_u32 << (s.motor_counter_bits - 1).min(30)) {
+            return Err(ConfigError::Overflow {
+                parameter: "sensors.motor_counter_bits",
+            });
+        }
+        let current_off =
+            positive(t.current_off_max_a, "thresholds.current_off_max_a")? / s.amps_per_count();
+        let lost = positive(t.max_lost_motion_rad, "thresholds.max_lost_motion_rad")?;
+        let impact_m = positive(t.impact_window_s, "thresholds.impact_window_s")? * tick_hz + 0.5;
+        require(
+            (1.0..32.0).contains(&impact_m),
+            "thresholds.impact_window_s",
+        )?;
+        let m = impact_m as u8; // 1 ≤ m < 32 (checked above)
+        let mh = f64::from(m) * h;
+        let j = c.mechanism.output_inertia_kg_m2;
+        Ok(SenseSettings {
+            adc_bits: s.current_adc_bits,
+            adc_max_code: ((1_u32 << s.current_adc_bits) - 1) as u16,
+            adc_rail_ticks: ticks(t.adc_rail_time_s, tick_hz, "thresholds.adc_rail_time_s")?,
+            current_off_counts: counts(current_off, "thresholds.current_off_max_a")?,
+            out_bits: s.output_encoder_bits,
+            out_mask: (1_u32 << s.output_encoder_bits) - 1,
+            out_shift: 32 - u32::from(s.output_encoder_bits),
+            out_jump_counts: counts(out_jump, "thresholds.max_output_speed_rad_s")?,
+            motor_bits: s.motor_counter_bits,
+            motor_mask: u32::MAX >> (32 - u32::from(s.motor_counter_bits)),
+            motor_jump_counts: counts(motor_jump, "thresholds.max_motor_speed_rad_s")?,
+            lost_motor_counts: counts(lost / in_rad, "thresholds.max_lost_motion_rad")? as u32,
+            lost_out_counts: counts(lost / out_rad, "thresholds.max_lost_motion_rad")? as u32,
+            input_speed: scale(in_rad / h * Q16_ONE, "sensors.motor_encoder_counts_per_rev")?,
+            input_alpha: filter_gain(
+                t.input_speed_filter_hz,
+                tick_hz,
+                Lane { ticks: 1 },
+                "thresholds.input_speed_filter_hz",
+            )?,
+            impact_window: m,
+            impact_torque: scale(
+                j * out_rad / (mh * mh) * Q16_ONE,
+                "thresholds.impact_window_s",
+            )?,
+        })
+    }
+
+    /// An output count as an angle word.
+    #[inline]
+    pub fn angle_word(&self, out: u32) -> u32 {
+        out << self.out_shift
+    }
+}
+
+/// What sensing hands on for one call.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Sensed {
+    /// Ticks covered (1 when on time, ≤ 255).
+    pub n: u32,
+    pub drive: bool,
+    /// The drive command changed (and on the first call).
+    pub drive_edge: bool,
+    /// First call since power-on.
+    pub first: bool,
+    /// Output and motor counters (masked), the output as an angle word.
+    pub out: u32,
+    pub motor: u32,
+    pub angle: u32,
+    /// The output counter of the previous call.
+    pub prev_out: u32,
+    pub d_out: i32,
+    pub out_ok: bool,
+    /// Phase current (ADC counts about mid-scale).
+    pub current: i32,
+    /// An implausible reading this call.
+    pub fault: bool,
+    /// The part of `fault` known before the counters' steps (ADC code, rail, range).
+    pub early_fault: bool,
+}
+
+/// The sensors' memory.
+#[derive(Clone, Debug)]
+pub(crate) struct Sense {
+    started: bool,
+    prev_out: u32,
+    prev_motor: u32,
+    prev_drive: bool,
+    rail_ticks: u32,
+    still_out: u32,
+    still_motor: u32,
+    input_speed: Q16,
+    positions: [i16; POSITION_HISTORY],
+    position_head: usize,
+    /// Consecutive on-time plausible ticks with the drive off in the history.
+    position_ticks: u32,
+}
+
+impl Sense {
+    pub const fn new() -> Sense {
+        Sense {
+            started: false,
+            prev_out: 0,
+            prev_motor: 0,
+            prev_drive: false,
+            rail_ticks: 0,
+            still_out: 0,
+            still_motor: 0,
+            input_speed: Q16::ZERO,
+            positions: [0; POSITION_HISTORY],
+            position_head: 0,
+            position_ticks: 0,
+        }
+    }
+
+    /// Reads one call's inputs. `carrying`: the previous call's scene was `Driving` (the stuck-
+    /// counter check runs only there).
+    pub fn read(&mut self, k: &SenseSettings, i: &Inputs, n: u32, carrying: bool) -> Sensed {
+        let n_i = n as i32; // ≤ 255
+        let code = i.current_adc_code;
+        let drive = i.drive_commanded;
+        let mut fault = code > k.adc_max_code; // the converter cannot produce it
+                                               // A drive at its current limit reads at the rail while the motor moves; a rail with
+                                               // the motor still is the ADC.
+        let motor_still = (i.motor_counter & k.motor_mask) == self.prev_motor;
+        let at_rail = code == 0 || code >= k.adc_max_code;
+        self.rail_ticks = if at_rail && (!drive || motor_still || !self.started) {
+            self.rail_ticks.saturating_add(n)
+        } else {
+            0
+        };
+        fault |= self.rail_ticks >= k.adc_rail_ticks;
+        let current = adc_centered(code, k.adc_bits); // |current| ≤ 2^15
+        fault |= !drive && current.saturating_abs() > k.current_off_counts;
+        fault |= i.output_counter > k.out_mask || i.motor_counter > k.motor_mask;
+        let early_fault = fault;
+        let out = i.output_counter & k.out_mask;
+        let motor = i.motor_counter & k.motor_mask;
+        let first = !self.started;
+        if first {
+            self.started = true;
+            self.prev_out = out;
+            self.prev_motor = motor;
+            self.prev_drive = !drive; // the first call is a drive edge
+        }
+        let prev_out = self.prev_out;
+        let d_out = counter_delta(self.prev_out, out, k.out_bits);
+        let d_motor = counter_delta(self.prev_motor, motor, k.motor_bits);
+        self.prev_out = out;
+        self.prev_motor = motor;
+        let out_ok = d_out.saturating_abs() <= times(k.out_jump_counts, n_i);
+        let motor_ok = d_motor.saturating_abs() <= times(k.motor_jump_counts, n_i);
+        self.record_position(drive, d_out, n == 1 && out_ok);
+        fault |= !out_ok || !motor_ok;
+        fault |= self.stuck_counter(k, carrying && drive && out_ok && motor_ok, d_out, d_motor);
+        if motor_ok && n == 1 {
+            let raw = Q16::from_bits(k.input_speed.apply(d_motor));
+            self.input_speed = lowpass(self.input_speed, raw, k.input_alpha);
+        }
+        let drive_edge = drive != self.prev_drive;
+        self.prev_drive = drive;
+        Sensed {
+            n,
+            drive,
+            drive_edge,
+            first,
+            out,
+            motor,
+            angle: k.angle_word(out),
+            prev_out,
+            d_out,
+            out_ok,
+            current,
+            fault,
+            early_fault,
+        }
+    }
+
+    /// Counters of the last call (the common-slip check restarts from them).
+    pub fn counters(&self) -> (u32, u32) {
+        (self.prev_out, self.prev_motor)
+    }
+
+    /// The input shaft's filtered speed.
+    pub fn input_speed(&self) -> Q16 {
+        self.input_speed
+    }
+
+    /// Stuck counter: while driving, one shaft travels beyond the lost-motion limit while the
+    /// other's counter stands still.
+    fn stuck_counter(&mut self, k: &SenseSettings, armed: bool, d_out: i32, d_motor: i32) -> bool {
+        if !armed {
+            self.still_out = 0;
+            self.still_motor = 0;
+            return false;
+        }
+        self.still_out = if d_out == 0 {
+            self.still_out.saturating_add(d_motor.unsigned_abs())
+        } else {
+            0
+        };
+        self.still_motor = if d_motor == 0 {
+            self.still_motor.saturating_add(d_out.unsigned_abs())
+        } else {
+            0
+        };
+        self.still_out > k.lost_motor_counts || self.still_motor > k.lost_out_counts
+    }
+
+    /// One history entry per call with the drive off (counts mod 2^16, wrapping: only
+    /// differences over ≤ 63 ticks are used); a late or implausible step, or the drive, restarts it.
+    fn record_position(&mut self, drive: bool, d_out: i32, on_time_ok: bool) {
+        if drive {
+            self.position_ticks = 0;
+            return;
+        }
+        let newest = self.positions.get(self.position_head).copied().unwrap_or(0);
+        self.position_head = (self.position_head + 1) % POSITION_HISTORY;
+        if let Some(slot) = self.positions.get_mut(self.position_head) {
+            *slot = newest.wrapping_add(d_out as i16); // |d_out| ≤ out_jump when used
+        }
+        self.position_ticks = if on_time_ok {
+            self.position_ticks.saturating_add(1)
+        } else {
+            0
+        };
+    }
+
+    /// `J_s·α` from the second difference of the position over two windows of `m` ticks
+    /// (`θ(t) − 2θ(t−m) + θ(t−2m)`); zero until the history holds `2m` on-time ticks.
+    pub fn impact_torque(&self, k: &SenseSettings) -> Q16 {
+        let m = usize::from(k.impact_window);
+        if self.position_ticks < 2 * u32::from(k.impact_window) {
+            return Q16::ZERO;
+        }
+        let at = |back: usize| {
+            self.positions
+                .get((self.position_head + POSITION_HISTORY - back) % POSITION_HISTORY)
+                .copied()
+                .unwrap_or(0)
+        };
+        // Wrapping (mod 2^16): the true second difference over 2m ≤ 62 ticks is far below 2^15.
+        let second = at(0)
+            .wrapping_sub(at(m).wrapping_mul(2))
+            .wrapping_add(at(2 * m));
+        Q16::from_bits(k.impact_torque.apply(i32::from(second)))
+    }
+}
+
+/// `x·n` for a tick count `n ≥ 1`, saturating; free when `n = 1` (every on-time call).
+#[inline]
+pub(crate) fn times(x: i32, n: i32) -> i32 {
+    if n == 1 {
+        x
+    } else {
+        x.saturating_mul(n)
+    }
+}

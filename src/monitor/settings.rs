@@ -1,0 +1,44 @@
+//! The monitor's settings: every stage's constants, built once from a [`Config`] by each
+//! stage's builder (in data order), apart from the state the step changes.
+
+use super::checks::CheckSettings;
+use super::config::{Config, ConfigError};
+use super::convert::{positive, require};
+use super::estimate::EstimateSettings;
+use super::load::LoadSettings;
+use super::observe::ObserveSettings;
+use super::pack::PackSettings;
+use super::scene::SceneSettings;
+use super::sense::SenseSettings;
+
+/// Every stage's settings.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) struct Settings {
+    pub sense: SenseSettings,
+    pub observe: ObserveSettings,
+    pub pack: PackSettings,
+    pub scene: SceneSettings,
+    pub load: LoadSettings,
+    pub estimate: EstimateSettings,
+    pub checks: CheckSettings,
+}
+
+impl Settings {
+    pub fn new(c: &Config) -> Result<Settings, ConfigError> {
+        let tick_hz = positive(c.tick_hz, "tick_hz")?;
+        require((100.0..=1.0e6).contains(&tick_hz), "tick_hz")?;
+        let max_load = positive(c.thresholds.max_load_nm, "thresholds.max_load_nm")?;
+        let (pack, ratios) = PackSettings::new(c, max_load)?;
+        let sense = SenseSettings::new(c)?;
+        let observe = ObserveSettings::new(c, &sense)?;
+        Ok(Settings {
+            sense,
+            observe,
+            pack,
+            scene: SceneSettings::new(c, observe.settle_ticks)?,
+            load: LoadSettings::new(c)?,
+            estimate: EstimateSettings::new(c)?,
+            checks: CheckSettings::new(c, &pack, &ratios)?,
+        })
+    }
+}
