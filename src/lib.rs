@@ -11,6 +11,7 @@
 //! - [`monitor`]: the 10 kHz reduced model, observer and failure flags.
 //! - [`reduced`]: the reduced output-shaft model, generic over number format and integrator
 //!   (the candidates of the speed-against-accuracy study, docs/speed-accuracy.md).
+//! - [`table1`]: the pack's stick/slip rule (Table 1), once for every number format.
 //! - [`fx`]: fixed-point formats and the small saturating/wrapping helpers the monitor uses.
 //! - [`vectors`]: test vectors run natively and under QEMU; the xtask compares the two digests.
 //! - [`board`], [`replay`], [`app`], [`event_log`]: the firmware's portable half — sensor
@@ -31,6 +32,7 @@ pub mod monitor;
 pub mod reduced;
 pub mod replay;
 pub mod sensors;
+pub mod table1;
 pub mod vectors;
 
 #[cfg(all(target_os = "none", feature = "platform"))]

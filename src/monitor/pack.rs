@@ -13,6 +13,7 @@ use super::config::{Config, ConfigError};
 use super::convert::{finite, positive, q16, require, scale, Q16_ENVELOPE};
 use super::scale::Scale;
 use crate::fx::Q16;
+use crate::table1::Motion;
 
 /// Exact (f64) ratios of the pack that other stages' constants derive from.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -125,18 +126,16 @@ impl PackSettings {
     }
 }
 
-/// Table 1 with the Karnopp stick band: stuck, the pack carries the demand up to its capacity;
-/// slipping, its capacity against the motion `dir` (−1, 0, 1).
+/// Table 1 ([`crate::table1`]) with the Karnopp stick band: stuck (or no direction), the pack
+/// carries the demand up to its capacity; slipping, its capacity along `dir`.
 #[inline]
 pub(crate) fn table1(stuck: bool, dir: Dir, demand: Q16, capacity: Q16) -> Q16 {
-    if stuck {
-        // min/max rather than `clamp`, which asserts min ≤ max: a capacity driven negative by a
-        // bad health or scale must bound, not panic.
-        let cap = capacity.max(Q16::ZERO);
-        demand.min(cap).max(cap.saturating_neg())
+    let motion = if stuck || dir.is_none() {
+        Motion::Stuck
     } else {
-        dir.apply(capacity)
-    }
+        Motion::Slipping { forward: dir.0 > 0 }
+    };
+    crate::table1::table1(motion, demand, capacity)
 }
 
 /// A direction of motion or load: −1, 0 (within a dead band) or +1.
