@@ -76,13 +76,14 @@ pub use io::{BrakeState, Estimate, Flags, Inputs, Scene, SceneModel, ESTIMATE_WO
 pub use scale::{recip_q16, sat_i32, Scale, ScaleError};
 
 use crate::fx::Q16;
-use checks::{CheckInputs, Checks};
+use checks::{BrakingTick, CheckInputs, Checks};
 use estimate::{Energy, PackInputs};
 use load::Load;
-use observe::Observe;
-use scene::Classify;
-use schedule::Slot;
-use sense::Sense;
+use observe::{Observe, Observed};
+use pack::Dir;
+use scene::{Classified, Classify};
+use schedule::{Slot, WINDOW};
+use sense::{Sense, Sensed};
 use settings::Settings;
 
 /// Largest capacity margin reported (loads below `min_load_nm` report this).
@@ -105,7 +106,11 @@ struct State {
     sense: Sense,
     observe: Observe,
     classify: Classify,
+    /// The last classification (the slow lane's checks read it).
+    classified: Classified,
     load: Load,
+    /// The estimate of the last classification (the slow lane's snapshot).
+    estimate: Estimate,
     energy: Energy,
     checks: Checks,
     flags: Flags,
@@ -131,19 +136,23 @@ impl Monitor {
     /// );
     /// ```
     pub fn new(config: Config) -> Result<Monitor, ConfigError> {
-        Ok(Monitor {
+        let mut monitor = Monitor {
             settings: Settings::new(&config)?,
             state: State {
                 tick: 0,
                 sense: Sense::new(),
                 observe: Observe::new(),
                 classify: Classify::new(),
+                classified: Classified::NONE,
                 load: Load::new(),
+                estimate: Estimate::NONE,
                 energy: Energy::new(),
                 checks: Checks::new(),
                 flags: Flags::default(),
             },
-        })
+        };
+        monitor.state.refresh_load(&monitor.settings);
+        Ok(monitor)
     }
 
     /// The model this monitor runs in `scene` (the cheapest per scene,
@@ -178,26 +187,88 @@ impl Monitor {
         let n = u32::from(inputs.ticks_elapsed.max(1));
         st.tick = st.tick.wrapping_add(n); // modular on purpose
         let slot = Slot::of(st.tick);
-        // Sense.
+        // Sense and observe, every tick.
         let carrying = st.classify.scene() == Scene::Driving;
         let x = st.sense.read(&k.sense, inputs, n, carrying);
-        // Observe.
         let o = st.observe.update(&k.observe, &x);
-        // Classify.
-        let step_counting = st.checks.step_counting(&k.checks);
-        let c = st.classify.update(
-            &k.scene,
-            &k.pack,
-            &x,
-            &o,
-            st.load.estimate,
-            step_counting,
-            slot,
-        );
-        // Estimate: the load (learned in the slow lane while driving steadily), its cache, the
-        // pack health (slow lane, slipping with the drive off), then the pack itself.
+        st.classify.tick(&x, &o);
+        st.checks.events(&k.checks, &x, &o);
         if x.drive_edge && x.drive {
             st.load.drive_started();
+        }
+        // The slow lane's part of this tick: classify and estimate, energy, checks, window.
+        let mut reading_switch = false;
+        match slot {
+            Slot::Classify => reading_switch = st.classify_and_estimate(k, &x, &o),
+            _ if x.first => reading_switch = st.classify_and_estimate(k, &x, &o),
+            Slot::Energy => {
+                let e = &st.estimate;
+                st.energy.update(
+                    &k.estimate,
+                    e.braking_torque_nm,
+                    e.output_speed_rad_s,
+                    !st.classify.locked(),
+                );
+            }
+            Slot::Sync if x.drive => st.classify.sync_window(&k.scene, &x, o.w),
+            _ => {}
+        }
+        let ci = CheckInputs {
+            slot,
+            drive_drag: k.pack.drive_drag,
+            min_load: k.scene.min_load,
+        };
+        let (slow, slow_gave_way) =
+            st.checks
+                .slow(&k.checks, &x, &o, &st.classified, &st.load, &ci);
+        // Check, every tick: the braking envelope and creep.
+        let dir = Dir::of(o.w, k.scene.stick_speed);
+        let braking = (st.classify.scene() == Scene::FaultBraking).then(|| BrakingTick {
+            n,
+            tick: st.tick,
+            d_out: x.d_out,
+            dir,
+            load_dir: Dir::of(st.load.estimate.value(), k.scene.min_load),
+            load_abs: st.load.estimate.value().saturating_abs(),
+            capacity: st.load.cache.capacity,
+        });
+        let (fast, fast_gave_way) = st.checks.every_tick(&k.checks, &x, &o, braking);
+        if slow_gave_way || fast_gave_way {
+            st.classify.lose_hold();
+        }
+        // The pack torque the observer's model feeds forward into the next prediction.
+        let model = estimate::model_torque(
+            &k.pack,
+            x.drive,
+            st.classify.locked(),
+            st.classify.overrunning(),
+            dir,
+            st.observe.disturbance().saturating_add(o.drive_torque),
+            o.drive_torque,
+            st.load.cache.capacity,
+        );
+        st.observe.set_model_torque(model, reading_switch);
+        // Flag: the one place flags are latched.
+        let mut raised = slow.union(fast);
+        raised.sensor_fault |= o.fault;
+        raised.overrun |= n > 1;
+        st.flags = st.flags.union(raised);
+        st.report(&o)
+    }
+}
+
+impl State {
+    /// The slow lane's [`Slot::Classify`]: the scene, then the load (learned while the drive
+    /// runs steadily) or the pack health (slipping with the drive off), then the pack's force
+    /// and torque. Returns whether the driving reading changed.
+    fn classify_and_estimate(&mut self, k: &Settings, x: &Sensed, o: &Observed) -> bool {
+        let step_counting = self.checks.step_counting(&k.checks);
+        let c = self
+            .classify
+            .update(&k.scene, &k.pack, x, o, self.load.estimate, step_counting);
+        self.classified = c;
+        if c.just_locked {
+            self.checks.locked(x);
         }
         let moving_ok = o.settled
             && o.sensors_ok
@@ -205,73 +276,44 @@ impl Monitor {
             && c.scene != Scene::Holding
             && c.phase_settled
             && !c.pending;
-        if moving_ok && x.drive && c.steady_for_learning && slot == Slot::LoadOrHealth {
+        if moving_ok && x.drive && c.steady_for_learning {
             let pack = if c.engaged() {
                 c.overrun_torque
             } else {
                 k.pack.drive_drag
             };
-            st.load
-                .learn(&k.load, o.net.saturating_add(c.dir.apply(pack)), n);
+            self.load
+                .learn(&k.load, o.net.saturating_add(c.dir.apply(pack)), x.n);
         }
+        let load = self.load.estimate.value();
         // The cache follows a changing load once per window while driving (never on a drive
         // edge); with the drive off the load is held, and so is the cache.
-        if !st.load.cache_valid()
-            || (st.load.cache_stale() && x.drive && slot == Slot::Refresh && !x.drive_edge)
-        {
-            let force = k.pack.clamped_force(st.load.estimate.value());
-            st.load.refresh(&k.load, k.pack.capacity(force));
+        if x.drive && !x.drive_edge && WINDOW.slot(self.tick) == 0 && self.load.cache_stale(load) {
+            self.refresh_load(k);
         }
-        let load = st.load.estimate.value();
         let measured = load.saturating_sub(o.net);
-        if moving_ok && !x.drive && st.load.estimate.known().is_some() && slot == Slot::LoadOrHealth
-        {
-            st.load.learn_health(&k.load, c.dir.apply(measured));
+        if moving_ok && !x.drive && self.load.estimate.known().is_some() {
+            self.load.learn_health(&k.load, c.dir.apply(measured));
         }
-        let locked = st.classify.locked();
+        let locked = self.classify.locked();
+        let held = if locked {
+            load.saturating_sub(self.sense.impact_torque(&k.sense))
+        } else {
+            load
+        };
         let pe = estimate::pack(
             &k.pack,
             &c,
             &PackInputs {
                 locked,
                 load,
-                held_torque: if locked {
-                    load.saturating_sub(st.sense.impact_torque(&k.sense))
-                } else {
-                    load
-                },
+                held_torque: held,
                 measured,
-                engaged_capacity: st.load.cache.capacity,
-                model_demand: st.observe.disturbance().saturating_add(o.drive_torque),
+                engaged_capacity: self.load.cache.capacity,
                 drive_torque: o.drive_torque,
             },
         );
-        st.observe
-            .set_model_torque(pe.model_torque, c.reading_switch);
-        let sample = slot == Slot::Energy;
-        st.energy
-            .update(&k.estimate, n, sample, !locked, pe.braking_torque, o.w);
-        // Check.
-        let ci = CheckInputs {
-            tick: st.tick,
-            slot,
-            drive_drag: k.pack.drive_drag,
-            min_load: k.scene.min_load,
-        };
-        let (raised, gave_way) = st.checks.run(&k.checks, &x, &o, &c, &st.load, &ci);
-        if gave_way {
-            st.classify.lose_hold();
-        }
-        // Flag: the one place flags are latched.
-        let raised = Flags {
-            sensor_fault: raised.sensor_fault || o.fault,
-            overrun: n > 1,
-            ..raised
-        };
-        st.flags = st.flags.union(raised);
-        let known = st.load.estimate.known().is_some();
-        Estimate {
-            tick: st.tick,
+        self.estimate = Estimate {
             scene: c.scene,
             brake: if locked {
                 BrakeState::Locked
@@ -286,16 +328,34 @@ impl Monitor {
             load_torque_nm: load,
             drive_torque_nm: o.drive_torque,
             output_speed_rad_s: o.w,
-            input_speed_rad_s: st.sense.input_speed(),
+            input_speed_rad_s: self.sense.input_speed(),
             capacity_margin: if load.saturating_abs() < k.scene.min_load {
                 MARGIN_MAX
             } else {
-                st.load.cache.margin
+                self.load.cache.margin
             },
-            pack_health: st.load.health,
-            friction_energy_j: st.energy.joules,
-            trusted: known && o.settled && o.sensors_ok && o.in_time,
-            flags: st.flags,
+            pack_health: self.load.health,
+            ..self.estimate
+        };
+        c.reading_switch
+    }
+
+    /// The load cache for the present load (its reciprocal and products).
+    fn refresh_load(&mut self, k: &Settings) {
+        let load = self.load.estimate.value();
+        let force = k.pack.clamped_force(load);
+        self.load.refresh(&k.load, load, k.pack.capacity(force));
+    }
+
+    /// The estimate of this tick: the last classification's, with this tick's count, energy,
+    /// trust and flags.
+    fn report(&self, o: &Observed) -> Estimate {
+        Estimate {
+            tick: self.tick,
+            friction_energy_j: self.energy.joules,
+            trusted: self.load.estimate.known().is_some() && o.settled && o.sensors_ok && o.in_time,
+            flags: self.flags,
+            ..self.estimate
         }
     }
 }

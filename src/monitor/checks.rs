@@ -1,14 +1,14 @@
-//! Checking: every failure check, one module per family, run after the estimate on the call's
-//! classification; [`Checks::run`] returns the flags raised this call (the monitor latches them
-//! in one place).
+//! Checking: every failure check, one module per family. Each returns the flags it raised
+//! this tick; the monitor latches them in one place.
 //!
 //! | family | flag | runs | module |
 //! |---|---|---|---|
-//! | capacity margin | `brake_weak` | every call | here |
-//! | braking envelope | `brake_weak` | `FaultBraking` | `envelope.rs` |
-//! | creep, common slip | `brake_slip` | drive off, held | `hold.rs`, `slip.rs` |
-//! | drag, steps of the drive's work | `brake_drag`, `sensor_fault` | drive on, slow lane | `drive.rs` |
-//! | dead current reading | `sensor_fault` | drive on, window lane | `dead_current.rs` |
+//! | braking envelope | `brake_weak` | every tick, `FaultBraking` | `envelope.rs` |
+//! | creep | `brake_slip` | every tick, drive off, held | `hold.rs` |
+//! | capacity margin | `brake_weak` | slow lane, `Checks` | here |
+//! | common slip | `brake_slip` | slow lane, `Checks`, drive off, held | `hold.rs`, `slip.rs` |
+//! | drag, steps of the drive's work | `brake_drag`, `sensor_fault` | slow lane, `Checks`, drive on | `drive.rs` |
+//! | dead current reading | `sensor_fault` | window lane, drive on | `dead_current.rs` |
 
 mod dead_current;
 mod drive;
@@ -25,15 +25,16 @@ use super::config::{Config, ConfigError};
 use super::convert::ticks;
 use super::load::Load;
 use super::observe::Observed;
-use super::pack::{Dir, PackRatios, PackSettings};
+use super::pack::{PackRatios, PackSettings};
 use super::scene::Classified;
-use super::schedule::Slot;
+use super::schedule::{Slot, SLOW};
 use super::sense::Sensed;
 use super::{Flags, Scene};
 use crate::fx::Q16;
 use dead_current::DeadCurrent;
 use drive::{DriveChecks, DriveTick};
-use envelope::{BrakingTick, Envelope};
+pub(crate) use envelope::BrakingTick;
+use envelope::Envelope;
 use hold::HoldChecks;
 
 /// The checks' constants.
@@ -68,7 +69,6 @@ impl CheckSettings {
 
 /// What the checks read besides the call's stages.
 pub(crate) struct CheckInputs {
-    pub tick: u32,
     pub slot: Slot,
     pub drive_drag: Q16,
     pub min_load: Q16,
@@ -108,9 +108,49 @@ impl Checks {
         self.hold.restart(counters.0, counters.1);
     }
 
-    /// Runs the checks of this call; returns the flags raised and whether the held brake gave
-    /// way (the classifier then leaves `Holding`).
-    pub fn run(
+    /// Every tick, first: an implausible step is no travel; a drive edge restarts the checks.
+    pub fn events(&mut self, k: &CheckSettings, x: &Sensed, o: &Observed) {
+        if o.fault {
+            self.hold.disarm_slip();
+        }
+        if x.drive_edge {
+            if !x.drive {
+                self.envelope.arm(&k.envelope, o.w);
+                self.hold.drive_cut();
+            }
+            self.hold.disarm_slip();
+            self.dead_current.disarm(x.out);
+        }
+    }
+
+    /// A new hold arms the held brake's checks.
+    pub fn locked(&mut self, x: &Sensed) {
+        self.hold.locked(x.out, x.motor);
+    }
+
+    /// The per-tick checks (braking envelope, creep); returns the flags raised and whether the
+    /// held brake gave way.
+    pub fn every_tick(
+        &mut self,
+        k: &CheckSettings,
+        x: &Sensed,
+        o: &Observed,
+        braking: Option<BrakingTick>,
+    ) -> (Flags, bool) {
+        let mut raised = Flags::default();
+        match braking {
+            Some(_) if !o.settled => self.envelope.arm(&k.envelope, o.w),
+            Some(b) if x.out_ok => raised.brake_weak = self.envelope.check(&k.envelope, &b),
+            _ => {}
+        }
+        let gave_way = !x.drive && x.out_ok && self.hold.creep(&k.hold, x.d_out);
+        raised.brake_slip = gave_way;
+        (raised, gave_way)
+    }
+
+    /// The slow lane's checks on their slots (`c`: the last classification); returns the flags
+    /// raised and whether the held brake gave way.
+    pub fn slow(
         &mut self,
         k: &CheckSettings,
         x: &Sensed,
@@ -120,74 +160,25 @@ impl Checks {
         i: &CheckInputs,
     ) -> (Flags, bool) {
         let mut raised = Flags::default();
-        let (n, drive) = (x.n, x.drive);
-        // Events first: an implausible step is no travel; a drive edge restarts the checks;
-        // a new hold arms the held brake's.
-        if o.fault {
-            self.hold.disarm_slip();
-        }
-        if x.drive_edge {
-            if !drive {
-                self.envelope.arm(&k.envelope, o.w);
-                self.hold.drive_cut();
-            }
-            self.hold.disarm_slip();
-            self.dead_current.disarm(x.out);
-        }
-        if c.just_locked {
-            self.hold.locked(x.out, x.motor);
-        }
-        // Capacity margin.
-        let load_abs = load.estimate.value().saturating_abs();
-        let margin_low = load.estimate.known().is_some()
-            && load_abs >= i.min_load
-            && load.cache.available < load.cache.margin_floor;
-        self.weak_ticks = if margin_low {
-            self.weak_ticks.saturating_add(n)
-        } else {
-            0
-        };
-        raised.brake_weak |= self.weak_ticks >= k.persistence_ticks;
-        // Braking envelope.
-        if c.scene == Scene::FaultBraking && !o.settled {
-            self.envelope.arm(&k.envelope, o.w);
-        } else if c.scene == Scene::FaultBraking && x.out_ok {
-            let b = BrakingTick {
-                n,
-                tick: i.tick,
-                d_out: x.d_out,
-                dir: c.dir,
-                load_dir: Dir::of(load.estimate.value(), i.min_load),
-                load_abs,
-                capacity: load.cache.capacity,
-            };
-            raised.brake_weak |= self.envelope.check(&k.envelope, &b);
-        }
-        // The held brake.
-        let mut gave_way = !drive && x.out_ok && self.hold.creep(&k.hold, x.d_out);
-        if !drive && i.slot == Slot::Checks {
-            gave_way |= self.hold.common_slip(&k.hold, x.out, x.motor);
-        }
-        raised.brake_slip |= gave_way;
-        // A dead current reading (unless a known load lies below the spring drag, where a pack
-        // whose spring broke could be driven by almost nothing).
-        if drive
-            && i.slot == Slot::DeadCurrent
-            && self
-                .dead_current
-                .window(o.drive_torque, x.out, &k.dead_current)
-            && o.settled
-            && o.sensors_ok
-            && load
-                .estimate
-                .known()
-                .is_none_or(|l| l.saturating_abs() >= i.drive_drag)
-        {
-            raised.sensor_fault = true;
-            self.drive.suspect_current();
-        }
-        // The running drive's checks, once it has run steadily for the observer's settling.
+        let mut gave_way = false;
+        let drive = x.drive;
         if i.slot == Slot::Checks {
+            // Capacity margin.
+            let load_abs = load.estimate.value().saturating_abs();
+            let margin_low = load.estimate.known().is_some()
+                && load_abs >= i.min_load
+                && load.cache.available < load.cache.margin_floor;
+            self.weak_ticks = if margin_low {
+                self.weak_ticks.saturating_add(SLOW.covered(x.n))
+            } else {
+                0
+            };
+            raised.brake_weak = self.weak_ticks >= k.persistence_ticks;
+            if !drive {
+                gave_way = self.hold.common_slip(&k.hold, x.out, x.motor);
+                raised.brake_slip = gave_way;
+            }
+            // The running drive's checks, once it has run steadily for the observer's settling.
             let checks_ok = o.settled
                 && o.sensors_ok
                 && !c.dir.is_none()
@@ -207,12 +198,29 @@ impl Checks {
                     carrying: c.scene == Scene::Driving,
                     load_ref: load.reference,
                     pending: c.pending,
-                    ticks: n,
+                    ticks: x.n,
                 };
                 raised = raised.union(self.drive.run(&k.drive, &t));
             } else {
                 self.drive.disarm();
             }
+        }
+        // A dead current reading (unless a known load lies below the spring drag, where a pack
+        // whose spring broke could be driven by almost nothing).
+        if drive
+            && i.slot == Slot::DeadCurrent
+            && self
+                .dead_current
+                .window(o.drive_torque, x.out, &k.dead_current)
+            && o.settled
+            && o.sensors_ok
+            && load
+                .estimate
+                .known()
+                .is_none_or(|l| l.saturating_abs() >= i.drive_drag)
+        {
+            raised.sensor_fault = true;
+            self.drive.suspect_current();
         }
         (raised, gave_way)
     }

@@ -19,9 +19,10 @@
 
 use super::config::{Config, ConfigError};
 use super::convert::scale;
-use super::pack::{table1, PackSettings};
+use super::pack::{table1, Dir, PackSettings};
 use super::scale::Scale;
 use super::scene::Classified;
+use super::schedule::SLOW;
 use super::{mul_q16, Scene};
 use crate::fx::Q16;
 use fixed::types::U40F24;
@@ -42,13 +43,34 @@ impl EstimateSettings {
     }
 }
 
-/// The pack's state this call.
+/// The pack's state at the last classification.
 #[derive(Clone, Copy, Debug)]
 pub(crate) struct PackEstimate {
     pub force: Q16,
     pub braking_torque: Q16,
-    /// The pack torque the observer's model feeds forward (Table 1 on its own load state).
-    pub model_torque: Q16,
+}
+
+/// The pack torque the observer's model feeds forward, every tick: Table 1 on the model's own
+/// demand (its load state plus the drive torque), so that a stuck model stays at rest whatever
+/// the observer has absorbed (Karnopp), with the capacity of the present reading.
+#[allow(clippy::too_many_arguments)]
+#[inline]
+pub(crate) fn model_torque(
+    k: &PackSettings,
+    drive: bool,
+    locked: bool,
+    overrunning: bool,
+    dir: Dir,
+    demand: Q16,
+    drive_torque: Q16,
+    engaged_capacity: Q16,
+) -> Q16 {
+    let capacity = match (drive, overrunning) {
+        (false, _) => engaged_capacity,
+        (true, false) => k.drive_drag,
+        (true, true) => k.overrun_torque(dir.apply(drive_torque)),
+    };
+    table1(locked || dir.is_none(), dir, demand, capacity)
 }
 
 /// What the pack estimate reads besides the classification.
@@ -61,8 +83,6 @@ pub(crate) struct PackInputs {
     pub measured: Q16,
     /// Capacity of the engaged pack at the load.
     pub engaged_capacity: Q16,
-    /// The observer's own load state plus the drive torque: the model's demand.
-    pub model_demand: Q16,
     pub drive_torque: Q16,
 }
 
@@ -111,15 +131,9 @@ pub(crate) fn pack(k: &PackSettings, c: &Classified, i: &PackInputs) -> PackEsti
         let cap = k.capacity(force).max(Q16::ZERO);
         torque.min(cap).max(cap.saturating_neg())
     };
-    let model_capacity = if c.scene == Scene::Overrunning {
-        c.overrun_torque
-    } else {
-        capacity
-    };
     PackEstimate {
         force,
         braking_torque,
-        model_torque: table1(stuck, dir, i.model_demand, model_capacity),
     }
 }
 
@@ -128,37 +142,22 @@ pub(crate) fn pack(k: &PackSettings, c: &Classified, i: &PackInputs) -> PackEsti
 #[derive(Clone, Copy, Debug)]
 pub(crate) struct Energy {
     pub joules: U40F24,
-    ticks: u32,
 }
 
 impl Energy {
     pub const fn new() -> Energy {
         Energy {
             joules: U40F24::ZERO,
-            ticks: 0,
         }
     }
 
-    /// Counts `n` ticks; on the energy slot, adds the slip power over them unless locked.
-    pub fn update(
-        &mut self,
-        k: &EstimateSettings,
-        n: u32,
-        sample: bool,
-        slipping: bool,
-        torque: Q16,
-        speed: Q16,
-    ) {
-        self.ticks = self.ticks.saturating_add(n);
-        if !sample {
-            return;
-        }
+    /// On the slow lane's energy slot: the slip power over the ticks since the last sample.
+    pub fn update(&mut self, k: &EstimateSettings, torque: Q16, speed: Q16, slipping: bool) {
         if slipping {
             let power = mul_q16(torque, speed).saturating_abs();
             let joules =
-                k.energy_per_tick.apply(power.to_bits()).max(0) as u64 * u64::from(self.ticks);
+                k.energy_per_tick.apply(power.to_bits()).max(0) as u64 * u64::from(SLOW.ticks);
             self.joules = U40F24::from_bits(self.joules.to_bits().saturating_add(joules));
         }
-        self.ticks = 0;
     }
 }

@@ -211,6 +211,25 @@ pub struct Estimate {
 }
 
 impl Estimate {
+    /// Before the first classification: braking with nothing known.
+    pub(crate) const NONE: Estimate = Estimate {
+        tick: 0,
+        scene: Scene::FaultBraking,
+        brake: BrakeState::Slipping,
+        pressing_force_n: Q16::ZERO,
+        braking_torque_nm: Q16::ZERO,
+        measured_braking_torque_nm: Q16::ZERO,
+        load_torque_nm: Q16::ZERO,
+        drive_torque_nm: Q16::ZERO,
+        output_speed_rad_s: Q16::ZERO,
+        input_speed_rad_s: Q16::ZERO,
+        capacity_margin: Q16::ZERO,
+        pack_health: Q16::ONE,
+        friction_energy_j: U40F24::ZERO,
+        trusted: false,
+        flags: Flags::from_bits(0),
+    };
+
     /// The estimate as words for streaming and digests: tick, force, braking torque, measured
     /// braking torque, load, drive torque, output speed, input speed, margin, health (Q16 bits
     /// as `u32`), energy low and high words, then `brake | scene << 8 | trusted << 16 |

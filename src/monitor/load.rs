@@ -84,7 +84,6 @@ impl LoadEstimate {
 #[derive(Clone, Copy, Debug)]
 pub(crate) struct LoadCache {
     load: Q16,
-    valid: bool,
     /// Static capacity `μ_s·c·(F_s + k·|M̂|)` of the pack clamped by the load (drive off).
     pub capacity: Q16,
     recip: Q16,
@@ -117,7 +116,6 @@ impl Load {
             health: Q16::ONE,
             cache: LoadCache {
                 load: Q16::ZERO,
-                valid: false,
                 capacity: Q16::ZERO,
                 recip: Q16::ZERO,
                 margin_floor: Q16::ZERO,
@@ -151,12 +149,11 @@ impl Load {
         };
     }
 
-    /// Refreshes the cache for the present load (`capacity_of`: capacity at a load).
-    pub fn refresh(&mut self, k: &LoadSettings, capacity: Q16) {
-        let load_abs = self.estimate.value().saturating_abs();
+    /// Refreshes the cache for `load` with its engaged `capacity`.
+    pub fn refresh(&mut self, k: &LoadSettings, load: Q16, capacity: Q16) {
+        let load_abs = load.saturating_abs();
         self.cache = LoadCache {
-            load: self.estimate.value(),
-            valid: true,
+            load,
             capacity,
             recip: Q16::from_bits(recip_q16(load_abs.to_bits())),
             margin_floor: Q16::from_bits(k.min_margin.apply(load_abs.to_bits())),
@@ -167,13 +164,9 @@ impl Load {
         self.cache_health();
     }
 
-    /// Whether the cache lags the load (or was never formed).
-    pub fn cache_stale(&self) -> bool {
-        self.cache.load != self.estimate.value()
-    }
-
-    pub fn cache_valid(&self) -> bool {
-        self.cache.valid
+    /// Whether the cache was formed for another load.
+    pub fn cache_stale(&self, load: Q16) -> bool {
+        self.cache.load != load
     }
 
     /// One slow-lane health step (sign-LMS, no division): the measured braking torque along

@@ -20,7 +20,7 @@ use super::load::LoadEstimate;
 use super::observe::Observed;
 use super::pack::{Dir, PackSettings};
 use super::scale::Scale;
-use super::schedule::{Slot, WINDOW};
+use super::schedule::WINDOW;
 use super::sense::Sensed;
 use super::{convert::scale, Scene};
 use crate::fx::{counter_delta, Q16};
@@ -116,6 +116,20 @@ pub(crate) struct Classified {
 }
 
 impl Classified {
+    /// Before the first classification.
+    pub const NONE: Classified = Classified {
+        scene: Scene::FaultBraking,
+        dir: Dir::NONE,
+        along: Q16::ZERO,
+        overrun_torque: Q16::ZERO,
+        pending: false,
+        reading_switch: false,
+        just_locked: false,
+        phase_settled: false,
+        steady_for_learning: false,
+        steady_for_checks: false,
+    };
+
     /// Ramps engaged: the drive off (both socket faces clamp) or overrunning.
     #[inline]
     pub fn engaged(&self) -> bool {
@@ -135,6 +149,8 @@ pub(crate) struct Classify {
     steady_ticks: u32,
     sync_out: u32,
     sync_motor: u32,
+    /// Ticks since the last classification.
+    since: u32,
 }
 
 impl Classify {
@@ -148,26 +164,15 @@ impl Classify {
             steady_ticks: 0,
             sync_out: 0,
             sync_motor: 0,
+            since: 0,
         }
     }
 
-    /// The previous call's scene.
-    pub fn scene(&self) -> Scene {
-        self.scene
-    }
-
-    #[allow(clippy::too_many_arguments)]
-    pub fn update(
-        &mut self,
-        k: &SceneSettings,
-        pack: &PackSettings,
-        x: &Sensed,
-        o: &Observed,
-        load: LoadEstimate,
-        step_counting: bool,
-        slot: Slot,
-    ) -> Classified {
-        let n = x.n;
+    /// Every tick, before anything else reads the classification: counts the tick; at power-on
+    /// takes the counters; at a drive edge leaves the held or driving state at once (the rest
+    /// waits for the next classification).
+    pub fn tick(&mut self, x: &Sensed, o: &Observed) {
+        self.since = self.since.saturating_add(x.n);
         if x.first {
             (self.sync_out, self.sync_motor) = (x.out, x.motor);
         }
@@ -176,7 +181,35 @@ impl Classify {
         }
         if x.drive_edge {
             self.steady_ticks = 0;
+            self.phase = if x.drive {
+                Phase::Driving(Reading::none())
+            } else {
+                Phase::Braking
+            };
         }
+    }
+
+    /// Whether the drive runs with the load along the motion (the pack carries it).
+    pub fn overrunning(&self) -> bool {
+        matches!(self.phase, Phase::Driving(r) if r.overrunning)
+    }
+
+    /// The previous call's scene.
+    pub fn scene(&self) -> Scene {
+        self.scene
+    }
+
+    /// Classifies the ticks since the last call (the slow lane's [`Slot::Classify`]).
+    pub fn update(
+        &mut self,
+        k: &SceneSettings,
+        pack: &PackSettings,
+        x: &Sensed,
+        o: &Observed,
+        load: LoadEstimate,
+        step_counting: bool,
+    ) -> Classified {
+        let n = core::mem::replace(&mut self.since, 0);
         let dir = Dir::of(o.w, k.stick_speed);
         let along = dir.apply(o.drive_torque);
         let known = load.known().is_some();
@@ -247,9 +280,6 @@ impl Classify {
         self.scene = scene;
         let steady_for_learning = self.steady_ticks >= k.engage_settle_ticks;
         let steady_for_checks = self.steady_ticks >= k.settle_ticks;
-        if x.drive && slot == Slot::Sync {
-            self.sync_window(k, x, dir);
-        }
         Classified {
             scene,
             dir,
@@ -279,7 +309,9 @@ impl Classify {
     /// Steady driving: the travel of both shafts over the last window agrees within the band
     /// (measured on the counters, not the observer, whose speed lags a step of the model's
     /// torque). An output that runs away from the input restarts the count.
-    fn sync_window(&mut self, k: &SceneSettings, x: &Sensed, dir: Dir) {
+    /// On the window lane's [`Slot::Sync`] with the drive on.
+    pub fn sync_window(&mut self, k: &SceneSettings, x: &Sensed, w: Q16) {
+        let dir = Dir::of(w, k.stick_speed);
         let d_o = counter_delta(self.sync_out, x.out, k.out_bits);
         let d_m = counter_delta(self.sync_motor, x.motor, k.motor_bits);
         (self.sync_out, self.sync_motor) = (x.out, x.motor);

@@ -1,21 +1,19 @@
 //! One schedule: every rate the monitor runs at, named once, and the slot of each tick.
 //!
-//! The tick (`Config::tick_hz`, 10 kHz by default) carries sensing, the observer, the scene
-//! and the estimate. Periodic work runs in *lanes* that divide the tick, each on its own slot so
-//! that no tick carries two of the costly parts:
+//! Two lanes. The **tick** (`Config::tick_hz`, 10 kHz by default) carries what the observer
+//! needs at the sensors' pace: sensing, the observer, the pack torque its model feeds forward,
+//! and the per-tick checks (braking envelope, creep). The **slow lane** ([`SLOW`], 2.5 kHz)
+//! carries the rest, one part per slot, so that no tick carries two of the costly parts:
 //!
-//! | lane | every | slot (tick mod lane) | drive on | drive off |
-//! |---|---|---|---|---|
-//! | [`SLOW`] | 4 ticks (2.5 kHz) | 0 | load filter | pack health |
-//! | | | 1 | drive checks | common-slip check |
-//! | | | 2 | friction energy | friction energy |
-//! | [`WINDOW`] | 16 ticks (625 Hz) | 3 | load-cache refresh | — |
-//! | | | 7 | synchronism window | — |
-//! | | | 15 | dead-current block | — |
-//! | braking model | `tick_hz / braking_model_hz` | odd ticks | — | nominal braking step |
+//! | slot (tick mod 4) | work | module |
+//! |---|---|---|
+//! | 0 [`Slot::Classify`] | scene, load filter or pack health (and once per [`WINDOW`] the load cache), the reported estimate | `scene`, `load`, `estimate` |
+//! | 1 [`Slot::Energy`] | friction energy | `estimate` |
+//! | 2 [`Slot::Checks`] | capacity margin, common slip (drive off), drive checks (drive on) | `checks` |
+//! | 3, by [`WINDOW`] (625 Hz): 7 / 15 | synchronism window / dead-current block (drive on) | `scene`, `checks` |
 //!
-//! A lane's filter gains and persistence counts are those of its own rate: each lane counts the
-//! ticks it covers (`Lane::covered`).
+//! The braking model (`tick_hz / braking_model_hz`) steps on odd ticks. A lane's filter gains
+//! and persistence counts are those of its own rate: each part counts the ticks it covers.
 
 /// A lane: periodic work every `ticks` ticks (a power of two, so the slot is a mask).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -48,18 +46,15 @@ pub const SLOW: Lane = Lane { ticks: 4 };
 /// The window lane: 625 Hz at 10 kHz (1.6 ms windows).
 pub const WINDOW: Lane = Lane { ticks: 16 };
 
-/// What periodic work a tick carries (in [`SLOW`], and in [`WINDOW`] on the slow lane's free
-/// slot).
+/// What slow-lane work a tick carries.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Slot {
-    /// Load filter (drive on) or pack health (drive off).
-    LoadOrHealth,
-    /// Drive checks (drive on) or the common-slip check (drive off).
-    Checks,
+    /// The scene, the load filter (drive on) or pack health (drive off), the pack estimate.
+    Classify,
     /// Friction energy.
     Energy,
-    /// Load-cache refresh (drive on).
-    Refresh,
+    /// Capacity margin; drive checks (drive on) or the common-slip check (drive off).
+    Checks,
     /// Synchronism window (drive on).
     Sync,
     /// Dead-current block sample (drive on).
@@ -73,11 +68,10 @@ impl Slot {
     #[inline]
     pub const fn of(tick: u32) -> Slot {
         match SLOW.slot(tick) {
-            0 => Slot::LoadOrHealth,
-            1 => Slot::Checks,
-            2 => Slot::Energy,
+            0 => Slot::Classify,
+            1 => Slot::Energy,
+            2 => Slot::Checks,
             _ => match WINDOW.slot(tick) {
-                3 => Slot::Refresh,
                 7 => Slot::Sync,
                 15 => Slot::DeadCurrent,
                 _ => Slot::Free,
@@ -85,8 +79,7 @@ impl Slot {
         }
     }
 
-    /// Whether the braking model may step on this tick (odd ticks: the even ones carry the
-    /// pack-health update).
+    /// Whether the braking model may step on this tick (odd ticks).
     #[inline]
     pub const fn braking_model_may_step(tick: u32) -> bool {
         tick & 1 == 1
@@ -99,14 +92,15 @@ mod tests {
 
     #[test]
     fn no_tick_carries_two_parts_and_every_part_has_its_slot() {
-        let mut seen = [0_u32; 7];
+        let mut seen = [0_u32; 6];
         for tick in 0..WINDOW.ticks {
             let i = Slot::of(tick) as usize;
             if let Some(count) = seen.get_mut(i) {
                 *count += 1;
             }
         }
-        // Four slow-lane slots per window each for the first three, one each for the window's.
-        assert_eq!(seen, [4, 4, 4, 1, 1, 1, 1]);
+        // Four slow-lane slots per window each for the first three, one each for the window's
+        // two, two free.
+        assert_eq!(seen, [4, 4, 4, 1, 1, 2]);
     }
 }

@@ -109,6 +109,7 @@ pub(crate) struct Envelope {
 }
 
 /// What one envelope call reads.
+#[derive(Clone, Copy, Debug)]
 pub(crate) struct BrakingTick {
     pub n: u32,
     pub tick: u32,
