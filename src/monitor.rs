@@ -106,8 +106,10 @@ struct State {
     sense: Sense,
     observe: Observe,
     classify: Classify,
-    /// The last classification (the slow lane's checks read it).
+    /// The last classification and the observer at that tick (the estimate and the slow
+    /// lane's checks read them).
     classified: Classified,
+    observed: Observed,
     load: Load,
     /// The estimate of the last classification (the slow lane's snapshot).
     estimate: Estimate,
@@ -144,6 +146,7 @@ impl Monitor {
                 observe: Observe::new(),
                 classify: Classify::new(),
                 classified: Classified::NONE,
+                observed: Observed::NONE,
                 load: Load::new(),
                 estimate: Estimate::NONE,
                 energy: Energy::new(),
@@ -199,17 +202,12 @@ impl Monitor {
         // The slow lane's part of this tick: classify and estimate, energy, checks, window.
         let mut reading_switch = false;
         match slot {
-            Slot::Classify => reading_switch = st.classify_and_estimate(k, &x, &o),
-            _ if x.first => reading_switch = st.classify_and_estimate(k, &x, &o),
-            Slot::Energy => {
-                let e = &st.estimate;
-                st.energy.update(
-                    &k.estimate,
-                    e.braking_torque_nm,
-                    e.output_speed_rad_s,
-                    !st.classify.locked(),
-                );
+            _ if x.first => {
+                reading_switch = st.classify(k, &x, &o);
+                st.estimate(k);
             }
+            Slot::Classify => reading_switch = st.classify(k, &x, &o),
+            Slot::Estimate => st.estimate(k),
             Slot::Sync if x.drive => st.classify.sync_window(&k.scene, &x, o.w),
             _ => {}
         }
@@ -259,14 +257,14 @@ impl Monitor {
 
 impl State {
     /// The slow lane's [`Slot::Classify`]: the scene, then the load (learned while the drive
-    /// runs steadily) or the pack health (slipping with the drive off), then the pack's force
-    /// and torque. Returns whether the driving reading changed.
-    fn classify_and_estimate(&mut self, k: &Settings, x: &Sensed, o: &Observed) -> bool {
+    /// runs steadily, cached once per window) or the pack health (slipping with the drive
+    /// off). Returns whether the driving reading changed.
+    fn classify(&mut self, k: &Settings, x: &Sensed, o: &Observed) -> bool {
         let step_counting = self.checks.step_counting(&k.checks);
         let c = self
             .classify
             .update(&k.scene, &k.pack, x, o, self.load.estimate, step_counting);
-        self.classified = c;
+        (self.classified, self.observed) = (c, *o);
         if c.just_locked {
             self.checks.locked(x);
         }
@@ -291,11 +289,21 @@ impl State {
         if x.drive && !x.drive_edge && WINDOW.slot(self.tick) == 0 && self.load.cache_stale(load) {
             self.refresh_load(k);
         }
-        let measured = load.saturating_sub(o.net);
         if moving_ok && !x.drive && self.load.estimate.known().is_some() {
+            let measured = load.saturating_sub(o.net);
             self.load.learn_health(&k.load, c.dir.apply(measured));
         }
-        let locked = self.classify.locked();
+        c.reading_switch
+    }
+
+    /// The slow lane's [`Slot::Estimate`]: the pack's force and torque at the last
+    /// classification (its snapshot of the observer), the input speed, the friction energy.
+    fn estimate(&mut self, k: &Settings) {
+        let (c, o) = (&self.classified, &self.observed);
+        self.sense.sample_input_speed(&k.sense);
+        let load = self.load.estimate.value();
+        let measured = load.saturating_sub(o.net);
+        let locked = c.scene == Scene::Holding;
         let held = if locked {
             load.saturating_sub(self.sense.impact_torque(&k.sense))
         } else {
@@ -303,7 +311,7 @@ impl State {
         };
         let pe = estimate::pack(
             &k.pack,
-            &c,
+            c,
             &PackInputs {
                 locked,
                 load,
@@ -313,6 +321,8 @@ impl State {
                 drive_torque: o.drive_torque,
             },
         );
+        self.energy
+            .update(&k.estimate, pe.braking_torque, o.w, !locked);
         self.estimate = Estimate {
             scene: c.scene,
             brake: if locked {
@@ -337,7 +347,6 @@ impl State {
             pack_health: self.load.health,
             ..self.estimate
         };
-        c.reading_switch
     }
 
     /// The load cache for the present load (its reciprocal and products).

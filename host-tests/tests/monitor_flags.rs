@@ -500,7 +500,9 @@ fn power_on_into_a_running_drive_seeds_the_observer_speed_unless_a_tick_is_late(
         let mut m = Monitor::new(Config::default()).unwrap();
         let mut e = None;
         let mut ticks = 0_u32;
-        for k in 0..noback::monitor::POWER_ON_SEED_TICKS + 4 {
+        // The estimate is the slow lane's snapshot: one slow period more before it shows.
+        let slow = noback::monitor::schedule::SLOW.ticks;
+        for k in 0..noback::monitor::POWER_ON_SEED_TICKS + 4 + slow {
             let n = if late_at == Some(k) { 2 } else { 1 };
             ticks += n;
             let out = (1000 + out_per_tick * ticks) & 0x3FFF;

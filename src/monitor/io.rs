@@ -164,8 +164,15 @@ impl Flags {
     }
 
     /// Flags raised in `self` or `other`.
+    #[inline]
     pub const fn union(self, other: Flags) -> Flags {
-        Flags::from_bits(self.bits() | other.bits())
+        Flags {
+            brake_slip: self.brake_slip | other.brake_slip,
+            brake_weak: self.brake_weak | other.brake_weak,
+            brake_drag: self.brake_drag | other.brake_drag,
+            sensor_fault: self.sensor_fault | other.sensor_fault,
+            overrun: self.overrun | other.overrun,
+        }
     }
 }
 

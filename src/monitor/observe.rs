@@ -128,6 +128,20 @@ pub(crate) struct Observed {
     pub head_start: u32,
 }
 
+impl Observed {
+    /// Before the first tick.
+    pub const NONE: Observed = Observed {
+        w: Q16::ZERO,
+        net: Q16::ZERO,
+        drive_torque: Q16::ZERO,
+        settled: false,
+        sensors_ok: false,
+        fault: false,
+        in_time: true,
+        head_start: 0,
+    };
+}
+
 /// The power-on seeding: after [`POWER_ON_SEED_TICKS`] on-time, plausible ticks the observer
 /// starts from the output's measured speed with its torque balanced, instead of at rest.
 #[derive(Clone, Copy, Debug, Default)]
@@ -199,6 +213,8 @@ impl Observe {
         if n > u32::from(k.max_catchup) {
             self.obs.theta = x.angle;
             self.settle_ticks = 0;
+        } else if n == 1 {
+            self.obs.predict(tau, &k.obs);
         } else {
             for _ in 0..n {
                 self.obs.predict(tau, &k.obs);
@@ -282,8 +298,7 @@ impl Observe {
     #[cold]
     #[inline(never)]
     fn seed_tick(&mut self, k: &ObserveSettings, x: &Sensed) -> u32 {
-        let step = counter_delta(x.prev_out, x.out, k.out_bits);
-        if x.n != 1 || x.early_fault || step.saturating_abs() > k.out_jump_counts {
+        if x.n != 1 || x.early_fault || x.d_out.saturating_abs() > k.out_jump_counts {
             self.seed.left = 0;
             return 0;
         }

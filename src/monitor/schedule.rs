@@ -7,8 +7,8 @@
 //!
 //! | slot (tick mod 4) | work | module |
 //! |---|---|---|
-//! | 0 [`Slot::Classify`] | scene, load filter or pack health (and once per [`WINDOW`] the load cache), the reported estimate | `scene`, `load`, `estimate` |
-//! | 1 [`Slot::Energy`] | friction energy | `estimate` |
+//! | 0 [`Slot::Classify`] | scene; load filter or pack health; once per [`WINDOW`] the load cache | `scene`, `load` |
+//! | 1 [`Slot::Estimate`] | the reported estimate at the classification, input speed, friction energy | `estimate`, `sense` |
 //! | 2 [`Slot::Checks`] | capacity margin, common slip (drive off), drive checks (drive on) | `checks` |
 //! | 3, by [`WINDOW`] (625 Hz): 7 / 15 | synchronism window / dead-current block (drive on) | `scene`, `checks` |
 //!
@@ -49,10 +49,10 @@ pub const WINDOW: Lane = Lane { ticks: 16 };
 /// What slow-lane work a tick carries.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Slot {
-    /// The scene, the load filter (drive on) or pack health (drive off), the pack estimate.
+    /// The scene, the load filter (drive on) or pack health (drive off).
     Classify,
-    /// Friction energy.
-    Energy,
+    /// The reported estimate, input speed and friction energy.
+    Estimate,
     /// Capacity margin; drive checks (drive on) or the common-slip check (drive off).
     Checks,
     /// Synchronism window (drive on).
@@ -69,7 +69,7 @@ impl Slot {
     pub const fn of(tick: u32) -> Slot {
         match SLOW.slot(tick) {
             0 => Slot::Classify,
-            1 => Slot::Energy,
+            1 => Slot::Estimate,
             2 => Slot::Checks,
             _ => match WINDOW.slot(tick) {
                 7 => Slot::Sync,

@@ -13,9 +13,9 @@
 use super::config::{Config, ConfigError};
 use super::convert::{counts, filter_gain, positive, require, scale, ticks, Q16_ENVELOPE, Q16_ONE};
 use super::scale::Scale;
-use super::schedule::Lane;
+use super::schedule::SLOW;
 use super::Inputs;
-use crate::fx::{adc_centered, counter_delta, lowpass, Gain, Q16};
+use crate::fx::{lowpass, Gain, Q16};
 
 /// Ticks of output-position history: a power of two above twice the longest impact window.
 const POSITION_HISTORY: usize = 64;
@@ -23,20 +23,23 @@ const POSITION_HISTORY: usize = 64;
 /// The sensors' constants.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub(crate) struct SenseSettings {
-    adc_bits: u8,
     adc_max_code: u16,
+    /// Mid-scale code (zero current).
+    adc_mid: i32,
     adc_rail_ticks: u32,
     current_off_counts: i32,
     pub out_bits: u8,
     out_mask: u32,
+    /// `32 − bits`: a counter shifted to the top so that wrapping `i32` arithmetic is its modulo.
     out_shift: u32,
     /// Largest plausible output step in one tick (counts).
     pub out_jump_counts: i32,
-    pub motor_bits: u8,
     motor_mask: u32,
+    motor_shift: u32,
     motor_jump_counts: i32,
     lost_motor_counts: u32,
     lost_out_counts: u32,
+    /// Motor counts over one slow-lane period → Q16 rad/s of the input shaft.
     input_speed: Scale<11>,
     input_alpha: Gain,
     /// Ticks `m` of the impact's second difference (1..=31).
@@ -80,7 +83,7 @@ impl SenseSettings {
             });
         }
         // A late step may cover `max_catchup_ticks` and must stay within half a counter period,
-        // or `counter_delta` would alias.
+        // or the wrapping difference would alias.
         let catchup = f64::from(c.max_catchup_ticks);
         let out_jump = max_out * h / out_rad + 1.0;
         let motor_jump = max_motor * h / (in_rad * ratio) + 1.0;
@@ -105,25 +108,29 @@ impl SenseSettings {
         let m = impact_m as u8; // 1 ≤ m < 32 (checked above)
         let mh = f64::from(m) * h;
         let j = c.mechanism.output_inertia_kg_m2;
+        let slow_h = h * f64::from(SLOW.ticks);
         Ok(SenseSettings {
-            adc_bits: s.current_adc_bits,
             adc_max_code: ((1_u32 << s.current_adc_bits) - 1) as u16,
+            adc_mid: 1 << (s.current_adc_bits - 1),
             adc_rail_ticks: ticks(t.adc_rail_time_s, tick_hz, "thresholds.adc_rail_time_s")?,
             current_off_counts: counts(current_off, "thresholds.current_off_max_a")?,
             out_bits: s.output_encoder_bits,
             out_mask: (1_u32 << s.output_encoder_bits) - 1,
             out_shift: 32 - u32::from(s.output_encoder_bits),
             out_jump_counts: counts(out_jump, "thresholds.max_output_speed_rad_s")?,
-            motor_bits: s.motor_counter_bits,
             motor_mask: u32::MAX >> (32 - u32::from(s.motor_counter_bits)),
+            motor_shift: 32 - u32::from(s.motor_counter_bits),
             motor_jump_counts: counts(motor_jump, "thresholds.max_motor_speed_rad_s")?,
             lost_motor_counts: counts(lost / in_rad, "thresholds.max_lost_motion_rad")? as u32,
             lost_out_counts: counts(lost / out_rad, "thresholds.max_lost_motion_rad")? as u32,
-            input_speed: scale(in_rad / h * Q16_ONE, "sensors.motor_encoder_counts_per_rev")?,
+            input_speed: scale(
+                in_rad / slow_h * Q16_ONE,
+                "sensors.motor_encoder_counts_per_rev",
+            )?,
             input_alpha: filter_gain(
                 t.input_speed_filter_hz,
                 tick_hz,
-                Lane { ticks: 1 },
+                SLOW,
                 "thresholds.input_speed_filter_hz",
             )?,
             impact_window: m,
@@ -132,12 +139,6 @@ impl SenseSettings {
                 "thresholds.impact_window_s",
             )?,
         })
-    }
-
-    /// An output count as an angle word.
-    #[inline]
-    pub fn angle_word(&self, out: u32) -> u32 {
-        out << self.out_shift
     }
 }
 
@@ -155,8 +156,6 @@ pub(crate) struct Sensed {
     pub out: u32,
     pub motor: u32,
     pub angle: u32,
-    /// The output counter of the previous call.
-    pub prev_out: u32,
     pub d_out: i32,
     pub out_ok: bool,
     /// Phase current (ADC counts about mid-scale).
@@ -178,6 +177,8 @@ pub(crate) struct Sense {
     still_out: u32,
     still_motor: u32,
     input_speed: Q16,
+    /// The motor counter at the last input-speed sample.
+    speed_motor: u32,
     positions: [i16; POSITION_HISTORY],
     position_head: usize,
     /// Consecutive on-time plausible ticks with the drive off in the history.
@@ -195,6 +196,7 @@ impl Sense {
             still_out: 0,
             still_motor: 0,
             input_speed: Q16::ZERO,
+            speed_motor: 0,
             positions: [0; POSITION_HISTORY],
             position_head: 0,
             position_ticks: 0,
@@ -204,46 +206,58 @@ impl Sense {
     /// Reads one call's inputs. `carrying`: the previous call's scene was `Driving` (the stuck-
     /// counter check runs only there).
     pub fn read(&mut self, k: &SenseSettings, i: &Inputs, n: u32, carrying: bool) -> Sensed {
-        let n_i = n as i32; // ≤ 255
         let code = i.current_adc_code;
         let drive = i.drive_commanded;
-        let mut fault = code > k.adc_max_code; // the converter cannot produce it
-                                               // A drive at its current limit reads at the rail while the motor moves; a rail with
-                                               // the motor still is the ADC.
-        let motor_still = (i.motor_counter & k.motor_mask) == self.prev_motor;
+        let out = i.output_counter & k.out_mask;
+        let motor = i.motor_counter & k.motor_mask;
+        // A drive at its current limit reads at the rail while the motor moves; a rail with
+        // the motor still is the ADC.
         let at_rail = code == 0 || code >= k.adc_max_code;
-        self.rail_ticks = if at_rail && (!drive || motor_still || !self.started) {
+        self.rail_ticks = if at_rail && (!drive || motor == self.prev_motor || !self.started) {
             self.rail_ticks.saturating_add(n)
         } else {
             0
         };
-        fault |= self.rail_ticks >= k.adc_rail_ticks;
-        let current = adc_centered(code, k.adc_bits); // |current| ≤ 2^15
-        fault |= !drive && current.saturating_abs() > k.current_off_counts;
-        fault |= i.output_counter > k.out_mask || i.motor_counter > k.motor_mask;
-        let early_fault = fault;
-        let out = i.output_counter & k.out_mask;
-        let motor = i.motor_counter & k.motor_mask;
+        let current = i32::from(code.min(k.adc_max_code)) - k.adc_mid;
+        let early_fault = code > k.adc_max_code // the converter cannot produce it
+            || self.rail_ticks >= k.adc_rail_ticks
+            || (!drive && (current > k.current_off_counts || -current > k.current_off_counts))
+            || out != i.output_counter
+            || motor != i.motor_counter;
         let first = !self.started;
         if first {
             self.started = true;
             self.prev_out = out;
             self.prev_motor = motor;
+            self.speed_motor = motor;
             self.prev_drive = !drive; // the first call is a drive edge
         }
-        let prev_out = self.prev_out;
-        let d_out = counter_delta(self.prev_out, out, k.out_bits);
-        let d_motor = counter_delta(self.prev_motor, motor, k.motor_bits);
+        let d_out = wrapping_delta(self.prev_out, out, k.out_shift);
+        let d_motor = wrapping_delta(self.prev_motor, motor, k.motor_shift);
         self.prev_out = out;
         self.prev_motor = motor;
-        let out_ok = d_out.saturating_abs() <= times(k.out_jump_counts, n_i);
-        let motor_ok = d_motor.saturating_abs() <= times(k.motor_jump_counts, n_i);
-        self.record_position(drive, d_out, n == 1 && out_ok);
-        fault |= !out_ok || !motor_ok;
-        fault |= self.stuck_counter(k, carrying && drive && out_ok && motor_ok, d_out, d_motor);
-        if motor_ok && n == 1 {
-            let raw = Q16::from_bits(k.input_speed.apply(d_motor));
-            self.input_speed = lowpass(self.input_speed, raw, k.input_alpha);
+        let (out_jump, motor_jump) = if n == 1 {
+            (k.out_jump_counts, k.motor_jump_counts)
+        } else {
+            let n = n as i32; // ≤ 255
+            (
+                k.out_jump_counts.saturating_mul(n),
+                k.motor_jump_counts.saturating_mul(n),
+            )
+        };
+        // Jump limits are ≥ 1 (positive): the unsigned comparison is exact.
+        let out_ok = d_out.unsigned_abs() <= out_jump as u32;
+        let motor_ok = d_motor.unsigned_abs() <= motor_jump as u32;
+        if !drive {
+            self.record_position(d_out, n == 1 && out_ok);
+        } else {
+            self.position_ticks = 0;
+        }
+        let stuck =
+            carrying && drive && out_ok && motor_ok && self.stuck_counter(k, d_out, d_motor);
+        if !(carrying && drive && out_ok && motor_ok) {
+            self.still_out = 0;
+            self.still_motor = 0;
         }
         let drive_edge = drive != self.prev_drive;
         self.prev_drive = drive;
@@ -254,14 +268,22 @@ impl Sense {
             first,
             out,
             motor,
-            angle: k.angle_word(out),
-            prev_out,
+            angle: out << k.out_shift,
             d_out,
             out_ok,
             current,
-            fault,
+            fault: early_fault || !out_ok || !motor_ok || stuck,
             early_fault,
         }
+    }
+
+    /// The input shaft's speed over the last slow-lane period (motor encoder ÷ ratio),
+    /// filtered; run on the slow lane's classification slot.
+    pub fn sample_input_speed(&mut self, k: &SenseSettings) {
+        let d = wrapping_delta(self.speed_motor, self.prev_motor, k.motor_shift);
+        self.speed_motor = self.prev_motor;
+        let raw = Q16::from_bits(k.input_speed.apply(d));
+        self.input_speed = lowpass(self.input_speed, raw, k.input_alpha);
     }
 
     /// Counters of the last call (the common-slip check restarts from them).
@@ -276,12 +298,7 @@ impl Sense {
 
     /// Stuck counter: while driving, one shaft travels beyond the lost-motion limit while the
     /// other's counter stands still.
-    fn stuck_counter(&mut self, k: &SenseSettings, armed: bool, d_out: i32, d_motor: i32) -> bool {
-        if !armed {
-            self.still_out = 0;
-            self.still_motor = 0;
-            return false;
-        }
+    fn stuck_counter(&mut self, k: &SenseSettings, d_out: i32, d_motor: i32) -> bool {
         self.still_out = if d_out == 0 {
             self.still_out.saturating_add(d_motor.unsigned_abs())
         } else {
@@ -296,14 +313,11 @@ impl Sense {
     }
 
     /// One history entry per call with the drive off (counts mod 2^16, wrapping: only
-    /// differences over ≤ 63 ticks are used); a late or implausible step, or the drive, restarts it.
-    fn record_position(&mut self, drive: bool, d_out: i32, on_time_ok: bool) {
-        if drive {
-            self.position_ticks = 0;
-            return;
-        }
-        let newest = self.positions.get(self.position_head).copied().unwrap_or(0);
-        self.position_head = (self.position_head + 1) % POSITION_HISTORY;
+    /// differences over ≤ 63 ticks are used); a late or implausible step restarts it.
+    fn record_position(&mut self, d_out: i32, on_time_ok: bool) {
+        let head = self.position_head % POSITION_HISTORY;
+        let newest = self.positions.get(head).copied().unwrap_or(0);
+        self.position_head = (head + 1) % POSITION_HISTORY;
         if let Some(slot) = self.positions.get_mut(self.position_head) {
             *slot = newest.wrapping_add(d_out as i16); // |d_out| ≤ out_jump when used
         }
@@ -333,6 +347,13 @@ impl Sense {
             .wrapping_add(at(2 * m));
         Q16::from_bits(k.impact_torque.apply(i32::from(second)))
     }
+}
+
+/// The signed difference `now − prev` of a counter shifted to the top by `shift` bits
+/// (wrapping: the counter is modular).
+#[inline]
+fn wrapping_delta(prev: u32, now: u32, shift: u32) -> i32 {
+    ((now << shift).wrapping_sub(prev << shift) as i32) >> shift
 }
 
 /// `x·n` for a tick count `n ≥ 1`, saturating; free when `n = 1` (every on-time call).
