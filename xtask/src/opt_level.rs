@@ -15,7 +15,7 @@ use std::fmt::Write as _;
 const LEVELS: [&str; 5] = ["1", "2", "3", "s", "z"];
 
 /// Entry: `opt-level` (no arguments).
-pub fn main(_args: &[String]) -> Result<i32, String> {
+pub fn main() -> Result<i32, String> {
     bootstrap::ensure_all()?;
     let replay = workspace_root()
         .join("target")

@@ -26,41 +26,21 @@ pub const REALTIME_SHIFT: u32 = 4;
 /// Bench boot: 2^10 ns per instruction, 12.8 (M0/M3) or 25.6 (M4F) SysTick ticks each.
 pub const BENCH_SHIFT: u32 = 10;
 
-struct Args {
-    scene: String,
-    core: Core,
-    json: bool,
-    overrun_at: Option<u32>,
-}
-
-fn parse(args: &[String]) -> Result<Args, String> {
-    let mut a = Args {
-        scene: "reverse_load".into(),
-        core: Core::M3,
-        json: false,
-        overrun_at: None,
-    };
-    let mut it = args.iter();
-    while let Some(arg) = it.next() {
-        match arg.as_str() {
-            "--core" => a.core = Core::parse(it.next().ok_or("--core needs a value")?)?,
-            "--scene" => a.scene = it.next().ok_or("--scene needs a name or file")?.clone(),
-            "--json" => a.json = true,
-            "--overrun-at" => {
-                a.overrun_at = Some(
-                    it.next()
-                        .and_then(|v| v.parse().ok())
-                        .ok_or("--overrun-at needs a tick number")?,
-                );
-            }
-            other => {
-                return Err(format!(
-                    "unknown argument `{other}` (run [--scene NAME|FILE|stress] [--core m0|m3|m4f] [--json] [--overrun-at TICK])"
-                ))
-            }
-        }
-    }
-    Ok(a)
+/// `cargo xtask run`'s options.
+#[derive(clap::Args, Debug)]
+pub struct RunArgs {
+    /// A built-in scene, a TOML scene file, or `stress` (synthetic hostile inputs).
+    #[arg(long, value_name = "NAME|FILE|stress", default_value = "reverse_load")]
+    pub scene: String,
+    /// The emulated core.
+    #[arg(long, value_parser = crate::core_arg, default_value = "m3", value_name = "m0|m3|m4f")]
+    pub core: Core,
+    /// Print the summary as one JSON object.
+    #[arg(long)]
+    pub json: bool,
+    /// Burn time in this tick to provoke a missed deadline (the overrun test).
+    #[arg(long, value_name = "TICK", allow_hyphen_values = true)]
+    pub overrun_at: Option<u32>,
 }
 
 /// `key=value` fields of a decoded log line.
@@ -119,8 +99,14 @@ fn flag_names(bits: u8) -> Vec<&'static str> {
 }
 
 /// Entry.
-pub fn main(args: &[String]) -> Result<i32, String> {
-    let a = parse(args)?;
+pub fn main(a: &RunArgs) -> Result<i32, String> {
+    // A bad scene (no such name or file, a bad value in the file, a parameter combination the
+    // twin cannot integrate) is bad input: exit 2 before anything is built.
+    if a.scene != STRESS {
+        if let Err(e) = noback_twin::cli::load_scene(&a.scene, None) {
+            return Ok(noback_twin::args::bad_input("run", &e));
+        }
+    }
     bootstrap::ensure_all()?;
     let reset_every = (a.scene == STRESS).then_some(STRESS_RESET_EVERY);
     let (report, ok) = replay_report(&a.scene, a.core, a.overrun_at, reset_every, !a.json)?;

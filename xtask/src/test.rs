@@ -15,19 +15,21 @@ use std::time::{Duration, Instant};
 /// The scene whose QEMU run is the snapshot test: the paper's reverse-load motor failure.
 pub const SNAPSHOT_SCENE: &str = "reverse_load";
 
-/// Entry: `test [--core m0|m3|m4f]… [--bless]` (default: all three cores; `--bless` rewrites
-/// the QEMU snapshot instead of comparing with it).
-pub fn main(args: &[String]) -> Result<i32, String> {
-    let mut cores = Vec::new();
-    let mut bless = false;
-    let mut it = args.iter();
-    while let Some(arg) = it.next() {
-        match arg.as_str() {
-            "--bless" => bless = true,
-            "--core" => cores.push(Core::parse(it.next().ok_or("--core needs a value")?)?),
-            other => return Err(format!("unknown argument `{other}` (try --core m0|m3|m4f)")),
-        }
-    }
+/// `cargo xtask test`'s options.
+#[derive(clap::Args, Debug)]
+pub struct TestArgs {
+    /// Test only these cores under QEMU (repeatable; default: all three).
+    #[arg(long, value_parser = crate::core_arg, value_name = "m0|m3|m4f")]
+    pub core: Vec<Core>,
+    /// Rewrite the QEMU snapshot instead of comparing with it.
+    #[arg(long)]
+    pub bless: bool,
+}
+
+/// Entry.
+pub fn main(a: &TestArgs) -> Result<i32, String> {
+    let mut cores = a.core.clone();
+    let bless = a.bless;
     if cores.is_empty() {
         cores = Core::ALL.to_vec();
     }
