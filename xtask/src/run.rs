@@ -152,8 +152,9 @@ pub fn replay_report(
         );
     }
 
-    let elf = build(core, &replay_path)?;
-    let mut rt_args = vec!["realtime".to_string()];
+    let elf = build(core)?;
+    let trace_arg = format!("trace={}", replay_path.display());
+    let mut rt_args = vec!["realtime".to_string(), trace_arg.clone()];
     if let Some(n) = overrun_at {
         rt_args.push(format!("overrun-at={n}"));
     }
@@ -161,7 +162,13 @@ pub fn replay_report(
         rt_args.push(format!("reset-every={n}"));
     }
     let realtime = boot(core, &elf, REALTIME_SHIFT, rt_args, echo)?;
-    let bench = boot(core, &elf, BENCH_SHIFT, vec!["bench".into()], false)?;
+    let bench = boot(
+        core,
+        &elf,
+        BENCH_SHIFT,
+        vec!["bench".into(), trace_arg],
+        false,
+    )?;
 
     let summary = line_with(&realtime.lines, "summary")?;
     let bench_line = line_with(&bench.lines, "bench")?;
@@ -195,7 +202,8 @@ pub fn replay_report(
         );
     }
     let size = elf_size::of_file(&elf)?;
-    let flash_bytes = size.flash_bytes.saturating_sub(bytes.len() as u64);
+    let flash_bytes = size.flash_bytes;
+    let starved = field::<u32>(&summary, "starved")? + field::<u32>(&bench_line, "starved")?;
     let stack_bytes: u32 = field(&summary, "stack_bytes")?;
     let isr_ticks_max: f64 = field::<u32>(&summary, "isr_ticks_max")?.into();
     let period_ticks: f64 = field::<u32>(&summary, "period_ticks")?.into();
@@ -244,6 +252,7 @@ pub fn replay_report(
         "ticks": ticks,
         "overruns": field::<u32>(&summary, "overruns")?,
         "missed_ticks": field::<u32>(&summary, "missed")?,
+        "stream_starved_ticks": starved,
         "log_overwritten": field::<u32>(&summary, "log_overwritten")?,
         "flags": flags,
         "insns_per_step_mean": (insns_mean * 10.0).round() / 10.0,
@@ -261,15 +270,19 @@ pub fn replay_report(
         "host_digest": format!("{:#010x}", host.totals.digest),
         "key_moments": moments,
     });
-    let ok = realtime.code == 0 && bench.code == 0 && bit_exact;
+    let ok = realtime.code == 0 && bench.code == 0 && bit_exact && starved == 0;
     Ok((report, ok))
 }
 
 fn print_summary(r: &serde_json::Value) {
     println!("\n=== summary ({} on {}) ===", r["scene"], r["core"]);
     println!(
-        "ticks {}  overruns {} (missed ticks {})  log events overwritten {}",
-        r["ticks"], r["overruns"], r["missed_ticks"], r["log_overwritten"]
+        "ticks {}  overruns {} (missed ticks {})  stream starved {}  log events overwritten {}",
+        r["ticks"],
+        r["overruns"],
+        r["missed_ticks"],
+        r["stream_starved_ticks"],
+        r["log_overwritten"]
     );
     let flags = r["flags"].as_array().cloned().unwrap_or_default();
     if flags.is_empty() {
@@ -290,7 +303,7 @@ fn print_summary(r: &serde_json::Value) {
         r["isr_insns_max"], r["deadline_used_pct"]
     );
     println!(
-        "flash {} B (+ {} B replay data), static RAM {} B, stack high-water {} B",
+        "flash {} B (replay streamed from the host: {} B), static RAM {} B, stack high-water {} B",
         r["flash_bytes"], r["replay_bytes"], r["ram_bytes"], r["stack_bytes_max"]
     );
     println!("     t_s  scene          brake      force N  (twin)   torque N·m (twin)");
@@ -312,14 +325,10 @@ fn print_summary(r: &serde_json::Value) {
     );
 }
 
-/// Builds the firmware for `core` in release with `replay` embedded; returns the ELF path.
-pub fn build(core: Core, replay: &std::path::Path) -> Result<String, String> {
-    build_bin(
-        "noback-fw",
-        core,
-        None,
-        &[("NOBACK_REPLAY", replay.as_os_str())],
-    )
+/// Builds the firmware for `core` in release; returns the ELF path. It streams its trace from
+/// the file named by its `trace=FILE` argument.
+pub fn build(core: Core) -> Result<String, String> {
+    build_bin("noback-fw", core, None, &[])
 }
 
 /// Builds a target binary of the `noback` package in release for `core` (into `target_dir`,
