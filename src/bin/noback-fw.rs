@@ -29,7 +29,8 @@ mod target {
     use noback::app::Ticker;
     use noback::board::SampleSource;
     use noback::digest::Fnv1a;
-    use noback::event_log::Event;
+    use noback::event_log::{tick_time, Decimal, Event};
+    use noback::monitor::{BrakeState, Scene};
     use noback::monitor::{Config, Monitor};
     use noback::platform::{self, meter::Meter, stack};
     use noback::replay::RECORD_BYTES;
@@ -289,6 +290,26 @@ mod target {
         platform::exit(noback::exit_code::SUCCESS)
     }
 
+    fn scene_name(scene: Scene) -> defmt::Str {
+        match scene {
+            Scene::Driving => defmt::intern!("driving"),
+            Scene::Holding => defmt::intern!("holding"),
+            Scene::FaultBraking => defmt::intern!("fault_braking"),
+            Scene::Overrunning => defmt::intern!("overrunning"),
+        }
+    }
+
+    fn brake_name(brake: BrakeState) -> defmt::Str {
+        match brake {
+            BrakeState::Released => defmt::intern!("released"),
+            BrakeState::Slipping => defmt::intern!("slipping"),
+            BrakeState::Locked => defmt::intern!("locked"),
+        }
+    }
+
+    /// One log line per event, in engineering units: `t` is the time of the sample the tick
+    /// stepped on (the trace's time base), forces in N, torques in N·m as magnitudes (the
+    /// trace's convention), flags as bits.
     fn log(event: &Event) {
         match *event {
             Event::State {
@@ -298,21 +319,35 @@ mod target {
                 pressing_force_bits,
                 braking_torque_bits,
                 flags,
-            } => defmt::info!(
-                "state tick={=u32} scene={=u8} brake={=u8} force_q16={=i32} torque_q16={=i32} flags={=u8:#04x}",
-                tick,
-                scene as u8,
-                brake as u8,
-                pressing_force_bits,
-                braking_torque_bits,
-                flags.bits()
-            ),
-            Event::FlagsChanged { tick, before, now } => defmt::warn!(
-                "flags tick={=u32} before={=u8:#04x} now={=u8:#04x}",
-                tick,
-                before.bits(),
-                now.bits()
-            ),
+            } => {
+                let (s, frac) = tick_time(tick);
+                let force = Decimal::from_q16(pressing_force_bits, 10);
+                let torque = Decimal::from_q16(braking_torque_bits.saturating_abs(), 100);
+                defmt::info!(
+                    "state t={=u32}.{=u32:04} s scene={=istr} brake={=istr} force={=str}{=u32}.{=u32:01} N torque={=u32}.{=u32:02} Nm flags={=u8:#04x}",
+                    s,
+                    frac,
+                    scene_name(scene),
+                    brake_name(brake),
+                    force.sign(),
+                    force.whole,
+                    force.frac,
+                    torque.whole,
+                    torque.frac,
+                    flags.bits()
+                )
+            }
+            Event::FlagsChanged { tick, before, now } => {
+                let (s, frac) = tick_time(tick);
+                defmt::warn!(
+                    "flags t={=u32}.{=u32:04} s tick={=u32} before={=u8:#04x} now={=u8:#04x}",
+                    s,
+                    frac,
+                    tick,
+                    before.bits(),
+                    now.bits()
+                )
+            }
             Event::Overrun { tick, missed } => {
                 defmt::warn!("overrun tick={=u32} missed={=u32}", tick, missed)
             }

@@ -297,6 +297,22 @@ impl RawFile {
             1,
             20,
         )?;
+        // Static friction below kinetic has no stick–slip switch the integrator can locate: the
+        // run ends in a step-size underflow (docs/decisions.md, Issue 20). Named here, at once.
+        if m.mu_static < m.mu_dynamic {
+            return Err(bad(
+                if raw.mu_static.is_some() {
+                    "mechanism.mu_static"
+                } else {
+                    "mechanism.mu_dynamic"
+                },
+                format!(
+                    "mu_static = {} is below mu_dynamic = {}: static friction must be ≥ kinetic",
+                    num(m.mu_static),
+                    num(m.mu_dynamic)
+                ),
+            ));
+        }
         if m.pack_inner_radius_m >= m.pack_outer_radius_m {
             return Err(bad(
                 "mechanism.pack_inner_radius_m",
@@ -405,7 +421,7 @@ impl RawFile {
             &mut o.axial_smoothing_m_s,
             ro.axial_smoothing_m_s,
             "open.axial_smoothing_m_s",
-            1e-9,
+            1e-6,
             1.0,
         )?;
         ranged(

@@ -48,7 +48,11 @@ pub fn main(a: &MonitorArgs) -> Result<i32, String> {
         }
     } else {
         match noback_twin::cli::load_scene(&target, None) {
-            Ok(scene) => (scene.faults.clone(), twin_trace(&target)?),
+            // The twin failing on a scene that passed the schema is still the scene's fault.
+            Ok(scene) => match twin_trace(&target) {
+                Ok(trace) => (scene.faults.clone(), trace),
+                Err(e) => return Ok(bad_input("monitor", &e)),
+            },
             Err(e) => return Ok(bad_input("monitor", &e)),
         }
     };
@@ -69,7 +73,7 @@ pub fn main(a: &MonitorArgs) -> Result<i32, String> {
     let flags: Vec<_> = acc
         .flags
         .iter()
-        .map(|f| json!({"flag": f.flag, "t_s": f.t_s}))
+        .map(|f| json!({"flag": f.flag, "t_s": (f.t_s * trace.sample_rate_hz).round() / trace.sample_rate_hz}))
         .collect();
     let report = json!({
         "scene": target,

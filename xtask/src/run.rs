@@ -109,7 +109,11 @@ pub fn main(a: &RunArgs) -> Result<i32, String> {
     }
     bootstrap::ensure_all()?;
     let reset_every = (a.scene == STRESS).then_some(STRESS_RESET_EVERY);
-    let (report, ok) = replay_report(&a.scene, a.core, a.overrun_at, reset_every, !a.json)?;
+    let (report, ok) = match replay_report(&a.scene, a.core, a.overrun_at, reset_every, !a.json) {
+        // The twin failing on a scene that passed the schema is still the scene's fault.
+        Err(e) if e.starts_with("twin: ") => return Ok(noback_twin::args::bad_input("run", &e)),
+        other => other?,
+    };
     if a.json {
         println!("{report}");
     } else {
@@ -208,6 +212,9 @@ pub fn replay_report(
     let isr_ticks_max: f64 = field::<u32>(&summary, "isr_ticks_max")?.into();
     let period_ticks: f64 = field::<u32>(&summary, "period_ticks")?.into();
 
+    // One time base: a flag raised on tick `n` was raised on the trace's sample `n − 1`, at
+    // its time (what `monitor` reports).
+    let rate = trace.sample_rate_hz;
     let flags: Vec<_> =
         realtime
             .lines
@@ -219,14 +226,15 @@ pub fn replay_report(
                 let before = hex(&f, "before").ok()? as u8;
                 let now = hex(&f, "now").ok()? as u8;
                 Some(flag_names(now & !before).into_iter().map(
-                    move |name| json!({"flag": name, "tick": tick, "t_s": f64::from(tick) / 1e4}),
+                    move |name| json!({"flag": name, "tick": tick, "t_s": f64::from(tick.saturating_sub(1)) / rate}),
                 ))
             })
             .flatten()
             .collect();
 
     // The estimate against the twin's truth every 0.1 s, from the host run (bit-identical to
-    // the firmware's when bit_exact holds).
+    // the firmware's when bit_exact holds). Braking torque as a magnitude, the trace's
+    // convention (the monitor's own field is signed, opposing the output's motion).
     let moments: Vec<_> = host
         .estimates
         .iter()
@@ -234,12 +242,12 @@ pub fn replay_report(
         .step_by(1000)
         .map(|(e, row)| {
             json!({
-                "t_s": row.t_s,
+                "t_s": (row.t_s * rate).round() / rate,
                 "scene": format!("{:?}", e.scene),
                 "brake": format!("{:?}", e.brake),
                 "pressing_force_n": e.pressing_force_n.to_num::<f64>(),
                 "twin_pressing_force_n": row.pressing_force_n,
-                "braking_torque_nm": e.braking_torque_nm.to_num::<f64>(),
+                "braking_torque_nm": e.braking_torque_nm.to_num::<f64>().abs(),
                 "twin_braking_torque_nm": row.braking_torque_nm,
             })
         })
