@@ -14,6 +14,7 @@ mod golden;
 mod monitor;
 mod monitor_mc;
 mod opt_level;
+mod pages;
 mod qemu;
 mod reliability;
 mod replay;

@@ -86,6 +86,8 @@ pub fn main(a: &TestArgs) -> Result<i32, String> {
     }
     section("host tests (library, host-tests, twin, xtask tidy)");
     shell::run(cargo().args(["test", "--workspace"]))?;
+    section("pages reproduce (reliability against its committed page, paper and monitor-mc twice)");
+    crate::pages::reproduce()?;
 
     let host_digest = noback::vectors::run().digest;
     let mut rows = Vec::new();
@@ -120,6 +122,8 @@ pub fn main(a: &TestArgs) -> Result<i32, String> {
             overrun_is_counted_and_flagged()?;
             section("load: hostile inputs, flags reset every 50 ticks (m3)");
             stress_stays_within_its_deadline()?;
+            section("one time base: a flag's time from run equals monitor's (m3)");
+            run_and_monitor_agree_on_time()?;
         }
         let fw_digest = u32::from_str_radix(
             report["fx_selfcheck_digest"]
@@ -259,6 +263,49 @@ fn stress_stays_within_its_deadline() -> Result<(), String> {
             "the load test missed its deadline, lost bit-exactness or did not load the flag path"
                 .into(),
         )
+    }
+}
+
+/// A fault scene through the firmware and through `monitor`'s comparison on the host: each flag
+/// must carry the same time (the trace's sample time) in both reports.
+fn run_and_monitor_agree_on_time() -> Result<(), String> {
+    let dir = crate::shell::workspace_root().join("target").join("replay");
+    std::fs::create_dir_all(&dir).map_err(|e| e.to_string())?;
+    let scene = dir.join("time_base.toml");
+    let text = "[scene]\nkind = \"reverse_load\"\n[[fault]]\nkind = \"encoder_stuck\"\nat_s = 0.1\nseverity = 1.0\n";
+    std::fs::write(&scene, text).map_err(|e| e.to_string())?;
+    let scene = scene.to_string_lossy().into_owned();
+    let (report, ok) = run::replay_report(&scene, Core::M3, None, None, false)?;
+    let trace = crate::replay::twin_trace(&scene)?;
+    let estimates = host_tests::accuracy::run_monitor(&trace, noback::monitor::Config::default())?;
+    let host = host_tests::accuracy::compare(&trace, &estimates);
+    let run_flags: Vec<(String, f64)> = report["flags"]
+        .as_array()
+        .into_iter()
+        .flatten()
+        .map(|f| {
+            (
+                f["flag"].as_str().unwrap_or("").to_string(),
+                f["t_s"].as_f64().unwrap_or(f64::NAN),
+            )
+        })
+        .collect();
+    let monitor_flags: Vec<(String, f64)> = host
+        .flags
+        .iter()
+        .map(|f| (f.flag.to_string(), f.t_s))
+        .collect();
+    println!("run: {run_flags:?}\nmonitor: {monitor_flags:?}");
+    let agree = !run_flags.is_empty()
+        && run_flags.len() == monitor_flags.len()
+        && run_flags
+            .iter()
+            .zip(&monitor_flags)
+            .all(|(a, b)| a.0 == b.0 && (a.1 - b.1).abs() < 0.5 / trace.sample_rate_hz);
+    if ok && agree {
+        Ok(())
+    } else {
+        Err("run and monitor report different flags or times on the same scene".into())
     }
 }
 
