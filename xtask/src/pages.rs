@@ -7,7 +7,7 @@ use std::process::Command;
 
 /// Runs this xtask with `args`; returns its stdout, failing on a non-zero exit.
 fn xtask(args: &[&str]) -> Result<String, String> {
-    let exe = std::env::current_exe().map_err(|e| e.to_string())?;
+    let exe = crate::shell::this_exe()?;
     println!("$ cargo xtask {}", args.join(" "));
     let out = Command::new(exe)
         .args(args)

@@ -165,7 +165,7 @@ fn section(title: &str) {
 /// Runs the defmt-test target tests for `core` under QEMU (this xtask as the cargo runner),
 /// echoing and returning their output lines.
 fn target_tests(core: Core) -> Result<Vec<String>, String> {
-    let exe = std::env::current_exe().map_err(|e| e.to_string())?;
+    let exe = crate::shell::this_exe()?;
     let runner_var = format!(
         "CARGO_TARGET_{}_RUNNER",
         core.triple().to_uppercase().replace('-', "_")
