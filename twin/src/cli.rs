@@ -4,7 +4,8 @@
 //! - `paper [--json] [--out FILE] [--tolerance TOL]`
 //! - `sweep pressing-force [--out DIR]` and `sweep PARAM=a..b [--scene S] [--steps N] [--reading R] [--out DIR]`
 //!
-//! Every error prints one clear line on stderr and returns exit code 2.
+//! Parsing is clap's, by the convention of `crate::args`: a bad argument or input prints one
+//! line naming it and returns exit code 2; a file that cannot be written returns 1.
 
 use crate::metrics::{self, Metrics};
 use crate::model::Sample;
