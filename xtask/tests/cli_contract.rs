@@ -172,12 +172,22 @@ fn bad_scene_files_are_refused_by_every_command_that_reads_one() {
         "kind.toml",
         &format!("[scene]\nkind = \"{}\"\n", "k".repeat(50_000)),
     );
+    let syntax = file(
+        "syntax.toml",
+        "[scene]\nkind = \"hold\"\n[mechanism]\nmu_static = = 3\n",
+    );
+    let fault = file(
+        "fault.toml",
+        "[scene]\nkind = \"hold\"\n[[fault]]\nkind = \"drag\"\nat_s = \"x\"\nseverity = 0.5\n",
+    );
     for (path, named) in [
         (missing.as_str(), "missing.toml"),
         (&nan, "scene.load_torque_nm"),
         (&typed, "mechanism.friction_discs"),
         (&huge, "1e308"),
         (&long_kind, "scene.kind"),
+        (&syntax, "mechanism.mu_static"),
+        (&fault, "fault[0].at_s"),
     ] {
         refused(&["run", "--scene", path], named);
         refused(&["monitor", path], named);
