@@ -156,6 +156,11 @@ impl<S: SampleSource, P: OutputPin> Ticker<S, P> {
         }
     }
 
+    /// The sample source (e.g. to read a stream's counters at the end of a run).
+    pub fn source(&self) -> &S {
+        &self.source
+    }
+
     /// The alarm pin (e.g. to read back its state in a test).
     pub fn alarm(&mut self) -> &mut P {
         &mut self.alarm

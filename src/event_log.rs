@@ -45,6 +45,47 @@ pub enum Event {
     },
 }
 
+/// A fixed-point value as the log prints it: sign, whole part and fraction digits, so the
+/// logger writes engineering units (`force=1184.4 N`) rather than raw Q16 bits.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Decimal {
+    /// Below zero (after rounding).
+    pub negative: bool,
+    /// Whole units.
+    pub whole: u32,
+    /// Fraction, in units of 1/`scale` (print zero-padded to the scale's digits).
+    pub frac: u32,
+}
+
+impl Decimal {
+    /// I16F16 `bits` rounded to 1/`scale` (10 for tenths, 100 for hundredths).
+    pub fn from_q16(bits: i32, scale: u32) -> Decimal {
+        let scale = u64::from(scale.max(1));
+        let scaled = (u64::from(bits.unsigned_abs()) * scale + (1 << 15)) >> 16;
+        Decimal {
+            negative: bits < 0 && scaled != 0,
+            whole: u32::try_from(scaled.checked_div(scale).unwrap_or(0)).unwrap_or(u32::MAX),
+            frac: u32::try_from(scaled.checked_rem(scale).unwrap_or(0)).unwrap_or(0),
+        }
+    }
+
+    /// `"-"` or `""`.
+    pub fn sign(&self) -> &'static str {
+        if self.negative {
+            "-"
+        } else {
+            ""
+        }
+    }
+}
+
+/// The time (s) of the sample a monitor tick stepped on, as whole seconds and 1/10 000 s: the
+/// trace's time base (sample `i` at `i`/10 kHz is stepped as tick `i + 1`).
+pub fn tick_time(tick: u32) -> (u32, u32) {
+    let sample = tick.saturating_sub(1);
+    (sample / 10_000, sample % 10_000)
+}
+
 /// Ring buffer of `N` events.
 pub struct EventLog<const N: usize> {
     queue: Deque<Event, N>,
@@ -105,6 +146,19 @@ mod tests {
 
     fn overrun(tick: u32) -> Event {
         Event::Overrun { tick, missed: 1 }
+    }
+
+    #[test]
+    fn fixed_point_prints_as_decimals_and_ticks_as_sample_times() {
+        let q16 = |v: f64| (v * 65_536.0).round() as i32;
+        let d = Decimal::from_q16(q16(1184.41), 10);
+        assert_eq!((d.sign(), d.whole, d.frac), ("", 1184, 4));
+        let d = Decimal::from_q16(q16(-1.98), 100);
+        assert_eq!((d.sign(), d.whole, d.frac), ("-", 1, 98));
+        let d = Decimal::from_q16(q16(-0.001), 100);
+        assert_eq!((d.sign(), d.whole, d.frac), ("", 0, 0));
+        assert_eq!(tick_time(4173), (0, 4172));
+        assert_eq!(tick_time(20_001), (2, 0));
     }
 
     #[test]

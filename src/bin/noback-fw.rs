@@ -1,16 +1,19 @@
 //! The actuator firmware image: the monitor at 10 kHz on a Cortex-M, here replaying a twin
-//! trace under QEMU (`cargo xtask run` builds it, embeds the trace and boots it).
+//! trace under QEMU (`cargo xtask run` builds it and boots it with `trace=FILE`, which the main
+//! loop streams from the host over semihosting into a ring the tick drains: any length).
 //!
 //! All target-only code of the product is in this file and `noback::platform`; the work of a
 //! tick is the portable `noback::app::Ticker`, which the host tests run too. Two modes, chosen
 //! by the semihosting argument QEMU passes:
 //! - `realtime` (default): SysTick interrupts at 10 kHz; each interrupt steps the monitor on
-//!   the next sample and drives the alarm pin; the main loop drains the log ring buffer to
-//!   defmt, so logging never blocks the interrupt. `overrun-at=N` burns time in tick N to
+//!   the next sample and drives the alarm pin; the main loop refills the sample ring from the
+//!   file and drains the log ring buffer to defmt, so neither reading nor logging blocks the
+//!   interrupt. `overrun-at=N` burns time in tick N to
 //!   provoke a missed deadline, which must be counted and flagged; `reset-every=N` has the
 //!   operator reset the flags after every N-th tick (the load test: flags keep changing).
 //! - `bench`: the same monitor steps back to back without interrupts, each `Monitor::step`
-//!   measured alone with SysTick, for deterministic instruction counts under QEMU `-icount`.
+//!   measured alone with SysTick (the file reads stay outside the measured span), for
+//!   deterministic instruction counts under QEMU `-icount`.
 //!
 //! Both end with a `summary` line carrying the digest of every estimate, which the xtask
 //! compares with the host's run on the same trace.
@@ -26,13 +29,17 @@ mod target {
     use noback::app::Ticker;
     use noback::board::SampleSource;
     use noback::digest::Fnv1a;
-    use noback::event_log::Event;
+    use noback::event_log::{tick_time, Decimal, Event};
+    use noback::monitor::{BrakeState, Scene};
     use noback::monitor::{Config, Monitor};
     use noback::platform::{self, meter::Meter, stack};
-    use noback::replay::Replay;
+    use noback::replay::RECORD_BYTES;
+    use noback::replay::{self, Feeder, StreamRing, Streamed, FEED_CHUNK, HEADER_BYTES};
+    use semihosting::fs::File;
+    use semihosting::io::Read;
 
-    /// The trace `cargo xtask run` embeds (`NOBACK_REPLAY`, copied by build.rs).
-    static TRACE: &[u8] = include_bytes!(concat!(env!("OUT_DIR"), "/replay.bin"));
+    /// Longest trace path the firmware accepts (bytes, without the NUL).
+    const PATH_BYTES: usize = 255;
 
     /// Board clock under QEMU (Hz): lm3s6965evb 12.5 MHz, mps2-an386 25 MHz.
     #[cfg(not(target_abi = "eabihf"))]
@@ -42,7 +49,7 @@ mod target {
     /// Tick rate.
     const TICK_HZ: u32 = 10_000;
 
-    type App = Ticker<Replay<'static>, AlarmPin>;
+    type App = Ticker<Streamed<'static>, AlarmPin>;
     static APP: Mutex<RefCell<Option<App>>> = Mutex::new(RefCell::new(None));
     /// Ticks elapsed to report on the next interrupt (2 after a missed deadline).
     static ELAPSED: AtomicU8 = AtomicU8::new(1);
@@ -83,10 +90,16 @@ mod target {
             fail("peripherals already taken")
         };
         let mut bench = false;
-        if let Ok(args) = semihosting::experimental::env::args::<128>() {
+        let mut path = [0_u8; PATH_BYTES + 1];
+        if let Ok(args) = semihosting::experimental::env::args::<512>() {
             for arg in args.flatten() {
                 if arg == "bench" {
                     bench = true;
+                } else if let Some(p) = arg.strip_prefix("trace=") {
+                    match path.get_mut(..p.len()) {
+                        Some(dst) if p.len() <= PATH_BYTES => dst.copy_from_slice(p.as_bytes()),
+                        _ => fail("the trace path is too long"),
+                    }
                 } else if let Some(n) = arg.strip_prefix("overrun-at=") {
                     OVERRUN_AT.store(n.parse().unwrap_or(u32::MAX), Ordering::Relaxed);
                 } else if let Some(n) = arg.strip_prefix("reset-every=") {
@@ -101,9 +114,23 @@ mod target {
             report.mismatches,
             report.digest
         );
-        let Ok(replay) = Replay::parse(TRACE) else {
-            fail("the embedded trace is not an NBR1 trace")
+        let Ok(path) = core::ffi::CStr::from_bytes_until_nul(&path) else {
+            fail("the trace path is not terminated")
         };
+        let Ok(mut file) = File::open(path) else {
+            fail("cannot open the trace file (pass trace=FILE)")
+        };
+        let mut header = [0_u8; HEADER_BYTES];
+        if file.read_exact(&mut header).is_err() {
+            fail("cannot read the trace header")
+        }
+        let Some(ring) = cortex_m::singleton!(: StreamRing = StreamRing::new()) else {
+            fail("the sample ring is already taken")
+        };
+        let Ok((mut feeder, replay)) = replay::stream(&header, ring) else {
+            fail("the trace is not an NBR1 trace")
+        };
+        feed(&mut feeder, &mut file);
         let Ok(monitor) = Monitor::new(Config::default()) else {
             fail("the default monitor configuration was rejected")
         };
@@ -115,17 +142,46 @@ mod target {
             if bench { "bench" } else { "realtime" }
         );
         if bench {
-            run_bench(replay, monitor, peripherals.SYST)
+            run_bench(replay, feeder, file, monitor, peripherals.SYST)
         } else {
             let app = Ticker::new(monitor, replay, AlarmPin { high: false });
-            run_realtime(app, peripherals.SYST)
+            run_realtime(app, feeder, file, peripherals.SYST)
+        }
+    }
+
+    /// Moves what the ring has room for from the file into it; returns whether it moved any.
+    /// A short or malformed file ends the run (the xtask wrote it: a fault, not a condition).
+    fn feed(feeder: &mut Feeder<'static>, file: &mut File) -> bool {
+        let mut moved = false;
+        loop {
+            let n = feeder.wanted();
+            if n == 0 {
+                return moved;
+            }
+            let mut chunk = [0_u8; FEED_CHUNK * RECORD_BYTES];
+            let Some(buf) = chunk.get_mut(..n * RECORD_BYTES) else {
+                return moved;
+            };
+            if file.read_exact(buf).is_err() {
+                fail("the trace file ended before its header's count")
+            }
+            if feeder.push(buf) != Ok(n) {
+                fail("a trace record has a reserved bit set")
+            }
+            moved = true;
         }
     }
 
     /// Steps the monitor back to back on the replay, measuring each `Monitor::step` alone (the
     /// digest and the logging stay outside the measured span). The digest equals the real-time
     /// run's: both fold every estimate's words in order.
-    fn run_bench(mut replay: Replay<'static>, mut monitor: Monitor, syst: SYST) -> ! {
+    fn run_bench(
+        mut replay: Streamed<'static>,
+        mut feeder: Feeder<'static>,
+        mut file: File,
+        mut monitor: Monitor,
+        syst: SYST,
+    ) -> ! {
         let meter = Meter::start(syst);
         let (a, b) = (meter.now(), meter.now());
         let overhead = Meter::ticks(a, b);
@@ -135,7 +191,11 @@ mod target {
         let mut scene_max = [0_u32; 4];
         let mut scene_max_at = [0_u32; 4];
         let mut digest = Fnv1a::new();
-        while let Some(inputs) = replay.sample() {
+        loop {
+            feed(&mut feeder, &mut file);
+            let Some(inputs) = replay.sample() else {
+                break;
+            };
             let start = meter.now();
             let estimate = monitor.step(&inputs);
             let ticks = Meter::ticks(start, meter.now()).saturating_sub(overhead);
@@ -152,12 +212,13 @@ mod target {
             digest.push(noback::app::estimate_checksum(&estimate));
         }
         defmt::info!(
-            "bench steps={=u32} ticks_sum={=u64} ticks_max={=u32} overhead={=u32} stack_bytes={=u32} digest={=u32:#010x}",
+            "bench steps={=u32} ticks_sum={=u64} ticks_max={=u32} overhead={=u32} stack_bytes={=u32} starved={=u32} digest={=u32:#010x}",
             steps,
             sum,
             max,
             overhead,
             stack::high_water_bytes(),
+            replay.starved(),
             digest.value()
         );
         defmt::info!(
@@ -174,8 +235,8 @@ mod target {
         platform::exit(noback::exit_code::SUCCESS)
     }
 
-    /// SysTick at 10 kHz drives the ticks; the main loop logs.
-    fn run_realtime(app: App, mut syst: SYST) -> ! {
+    /// SysTick at 10 kHz drives the ticks; the main loop refills the sample ring and logs.
+    fn run_realtime(app: App, mut feeder: Feeder<'static>, mut file: File, mut syst: SYST) -> ! {
         critical_section::with(|cs| APP.borrow(cs).replace(Some(app)));
         syst.set_clock_source(SystClkSource::Core);
         syst.set_reload(CLOCK_HZ / TICK_HZ - 1);
@@ -183,6 +244,7 @@ mod target {
         syst.enable_interrupt();
         syst.enable_counter();
         loop {
+            let fed = feed(&mut feeder, &mut file);
             let event = critical_section::with(|cs| {
                 APP.borrow(cs)
                     .borrow_mut()
@@ -192,6 +254,7 @@ mod target {
             match event {
                 Some(event) => log(&event),
                 None if DONE.load(Ordering::Acquire) => break,
+                None if fed => {}
                 None => cortex_m::asm::wfi(),
             }
         }
@@ -211,10 +274,11 @@ mod target {
         let t = app.totals();
         let last = app.last_estimate();
         defmt::info!(
-            "summary ticks={=u32} overruns={=u32} missed={=u32} log_overwritten={=u32} alarm_errors={=u32} flags={=u8:#04x} stack_bytes={=u32} isr_ticks_max={=u32} period_ticks={=u32} digest={=u32:#010x}",
+            "summary ticks={=u32} overruns={=u32} missed={=u32} starved={=u32} log_overwritten={=u32} alarm_errors={=u32} flags={=u8:#04x} stack_bytes={=u32} isr_ticks_max={=u32} period_ticks={=u32} digest={=u32:#010x}",
             t.ticks,
             t.overruns,
             t.missed_ticks,
+            app.source().starved(),
             t.log_overwritten,
             t.alarm_errors,
             last.map_or(0, |e| e.flags.bits()),
@@ -226,6 +290,26 @@ mod target {
         platform::exit(noback::exit_code::SUCCESS)
     }
 
+    fn scene_name(scene: Scene) -> defmt::Str {
+        match scene {
+            Scene::Driving => defmt::intern!("driving"),
+            Scene::Holding => defmt::intern!("holding"),
+            Scene::FaultBraking => defmt::intern!("fault_braking"),
+            Scene::Overrunning => defmt::intern!("overrunning"),
+        }
+    }
+
+    fn brake_name(brake: BrakeState) -> defmt::Str {
+        match brake {
+            BrakeState::Released => defmt::intern!("released"),
+            BrakeState::Slipping => defmt::intern!("slipping"),
+            BrakeState::Locked => defmt::intern!("locked"),
+        }
+    }
+
+    /// One log line per event, in engineering units: `t` is the time of the sample the tick
+    /// stepped on (the trace's time base), forces in N, torques in N·m as magnitudes (the
+    /// trace's convention), flags as bits.
     fn log(event: &Event) {
         match *event {
             Event::State {
@@ -235,21 +319,35 @@ mod target {
                 pressing_force_bits,
                 braking_torque_bits,
                 flags,
-            } => defmt::info!(
-                "state tick={=u32} scene={=u8} brake={=u8} force_q16={=i32} torque_q16={=i32} flags={=u8:#04x}",
-                tick,
-                scene as u8,
-                brake as u8,
-                pressing_force_bits,
-                braking_torque_bits,
-                flags.bits()
-            ),
-            Event::FlagsChanged { tick, before, now } => defmt::warn!(
-                "flags tick={=u32} before={=u8:#04x} now={=u8:#04x}",
-                tick,
-                before.bits(),
-                now.bits()
-            ),
+            } => {
+                let (s, frac) = tick_time(tick);
+                let force = Decimal::from_q16(pressing_force_bits, 10);
+                let torque = Decimal::from_q16(braking_torque_bits.saturating_abs(), 100);
+                defmt::info!(
+                    "state t={=u32}.{=u32:04} s scene={=istr} brake={=istr} force={=str}{=u32}.{=u32:01} N torque={=u32}.{=u32:02} Nm flags={=u8:#04x}",
+                    s,
+                    frac,
+                    scene_name(scene),
+                    brake_name(brake),
+                    force.sign(),
+                    force.whole,
+                    force.frac,
+                    torque.whole,
+                    torque.frac,
+                    flags.bits()
+                )
+            }
+            Event::FlagsChanged { tick, before, now } => {
+                let (s, frac) = tick_time(tick);
+                defmt::warn!(
+                    "flags t={=u32}.{=u32:04} s tick={=u32} before={=u8:#04x} now={=u8:#04x}",
+                    s,
+                    frac,
+                    tick,
+                    before.bits(),
+                    now.bits()
+                )
+            }
             Event::Overrun { tick, missed } => {
                 defmt::warn!("overrun tick={=u32} missed={=u32}", tick, missed)
             }

@@ -4,7 +4,8 @@
 //! - `paper [--json] [--out FILE] [--tolerance TOL]`
 //! - `sweep pressing-force [--out DIR]` and `sweep PARAM=a..b [--scene S] [--steps N] [--reading R] [--out DIR]`
 //!
-//! Every error prints one clear line on stderr and returns exit code 2.
+//! Parsing is clap's, by the convention of `crate::args`: a bad argument or input prints one
+//! line naming it and returns exit code 2; a file that cannot be written returns 1.
 
 use crate::metrics::{self, Metrics};
 use crate::model::Sample;
@@ -19,8 +20,9 @@ use std::path::{Path, PathBuf};
 
 pub use crate::sweep::sweep_main;
 
-/// Exit code of a usage or input error.
-pub const EXIT_USAGE: i32 = 2;
+pub use crate::args::EXIT_USAGE;
+use crate::args::{self, bad_input};
+use clap::Parser;
 
 /// Dispatch `twin ...`, `paper ...` or `sweep ...` by the first argument (for the example
 /// binary); anything else is taken as `twin` arguments.
@@ -33,9 +35,10 @@ pub fn dispatch(args: &[String]) -> i32 {
     }
 }
 
-fn fail(msg: &str) -> i32 {
-    eprintln!("error: {msg}");
-    EXIT_USAGE
+/// An internal failure (a file that cannot be written): exit 1.
+fn internal(prog: &str, msg: &str) -> i32 {
+    eprintln!("xtask {prog}: error: {msg}");
+    1
 }
 
 /// Default output directory for runs.
@@ -43,57 +46,45 @@ pub fn default_out_dir() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../target/twin")
 }
 
-struct TwinArgs {
-    target: String,
-    reading: Option<Reading>,
-    out: PathBuf,
-    json: bool,
-    tolerance: Option<f64>,
+/// A clap value parser: `paper` or `physical`.
+pub fn reading_arg(s: &str) -> Result<Reading, String> {
+    Reading::parse(s).ok_or_else(|| "expected paper or physical".into())
 }
 
-fn parse_twin_args(args: &[String]) -> Result<TwinArgs, String> {
-    let mut it = args.iter();
-    let mut a = TwinArgs {
-        target: String::new(),
-        reading: None,
-        out: default_out_dir(),
-        json: false,
-        tolerance: None,
-    };
-    while let Some(arg) = it.next() {
-        match arg.as_str() {
-            "--reading" => {
-                let v = it.next().ok_or("--reading needs paper or physical")?;
-                a.reading = Some(
-                    Reading::parse(v)
-                        .ok_or_else(|| format!("--reading `{v}`: expected paper or physical"))?,
-                );
-            }
-            "--out" => a.out = PathBuf::from(it.next().ok_or("--out needs a directory")?),
-            "--json" => a.json = true,
-            "--tolerance" => {
-                let v = it.next().ok_or("--tolerance needs a number")?;
-                let t: f64 = v
-                    .parse()
-                    .map_err(|_| format!("--tolerance `{v}` is not a number"))?;
-                if !(t > 1e-10 && t < 1e-2) {
-                    return Err(format!("--tolerance {t} is out of range (1e-10, 1e-2)"));
-                }
-                a.tolerance = Some(t);
-            }
-            s if s.starts_with("--") => return Err(format!("unknown option `{s}`")),
-            s => {
-                if !a.target.is_empty() {
-                    return Err(format!("unexpected argument `{s}` (one scene per run)"));
-                }
-                a.target = s.to_string();
-            }
-        }
-    }
-    if a.target.is_empty() {
-        return Err("usage: twin SCENE|FILE [--reading paper|physical] [--out DIR] [--json] [--tolerance TOL]; scenes: reverse_load forward_load continuous_closing hold drive".into());
-    }
-    Ok(a)
+/// A clap value parser: a built-in scene name.
+pub fn scene_kind_arg(s: &str) -> Result<SceneKind, String> {
+    SceneKind::parse(s).ok_or_else(|| format!("not a built-in scene ({BUILTINS})"))
+}
+
+/// The built-in scenes, as messages list them.
+pub const BUILTINS: &str = "reverse_load, forward_load, continuous_closing, hold, drive";
+
+/// `cargo xtask twin`: run the digital twin on one scene.
+#[derive(clap::Args, Debug, Clone)]
+pub struct TwinArgs {
+    /// A built-in scene (reverse_load, forward_load, continuous_closing, hold, drive) or a TOML
+    /// scene file.
+    #[arg(value_name = "SCENE|FILE")]
+    pub target: String,
+    /// The model reading (default: the scene's, physical for built-ins).
+    #[arg(long, value_parser = reading_arg, value_name = "paper|physical")]
+    pub reading: Option<Reading>,
+    /// Where the CSV, the trace and the SVG go.
+    #[arg(long, value_name = "DIR", default_value_os_t = default_out_dir())]
+    pub out: PathBuf,
+    /// Print the metrics as one JSON object.
+    #[arg(long)]
+    pub json: bool,
+    /// The integrator's tolerance, in (1e-10, 1e-2).
+    #[arg(long, allow_hyphen_values = true, value_parser = args::tolerance, value_name = "TOL")]
+    pub tolerance: Option<f64>,
+}
+
+#[derive(Parser)]
+#[command(about = "Run the digital twin on one scene")]
+struct TwinCmd {
+    #[command(flatten)]
+    a: TwinArgs,
 }
 
 /// Load a scene by built-in name or TOML file path.
@@ -102,10 +93,13 @@ pub fn load_scene(target: &str, reading: Option<Reading>) -> Result<Scene, Strin
         Scene::builtin(kind, reading.unwrap_or_default())
     } else {
         let path = Path::new(target);
-        if !path.exists() {
-            return Err(format!("`{target}` is neither a built-in scene (reverse_load, forward_load, continuous_closing, hold, drive) nor a file"));
+        if !path.is_file() {
+            return Err(format!(
+                "`{}` is neither a built-in scene ({BUILTINS}) nor a file",
+                args::short(target)
+            ));
         }
-        Scene::from_file(path).map_err(|e| format!("{}: {e}", path.display()))?
+        Scene::from_file(path).map_err(|e| format!("{}: {e}", args::short(target)))?
     };
     if let Some(r) = reading {
         scene.reading = r;
@@ -113,32 +107,36 @@ pub fn load_scene(target: &str, reading: Option<Reading>) -> Result<Scene, Strin
     Ok(scene)
 }
 
-/// `twin SCENE|FILE [--reading paper|physical] [--out DIR] [--json]`.
+/// `twin SCENE|FILE [--reading paper|physical] [--out DIR] [--json]` from raw arguments.
 pub fn twin_main(args: &[String]) -> i32 {
-    let a = match parse_twin_args(args) {
-        Ok(a) => a,
-        Err(e) => return fail(&e),
-    };
+    match args::parse::<TwinCmd>("twin", args) {
+        Ok(c) => twin_run(&c.a),
+        Err(code) => code,
+    }
+}
+
+/// `twin` with parsed arguments.
+pub fn twin_run(a: &TwinArgs) -> i32 {
     let mut scene = match load_scene(&a.target, a.reading) {
         Ok(s) => s,
-        Err(e) => return fail(&e),
+        Err(e) => return bad_input("twin", &e),
     };
     if let Some(t) = a.tolerance {
         scene.tolerance = t;
     }
     let run = match sim::run(&scene) {
         Ok(r) => r,
-        Err(e) => return fail(&format!("scene {}: {e}", scene.name)),
+        Err(e) => return bad_input("twin", &format!("scene {}: {e}", scene.name)),
     };
     let m = metrics::compute(&scene, &run.samples, &run.stats, run.wall_s);
     let stem = format!("{}-{}", scene.name, scene.reading.name());
     if let Err(e) = write_outputs(&a.out, &stem, &scene, &run.samples) {
-        return fail(&e);
+        return internal("twin", &e);
     }
     if a.json {
         match serde_json::to_string(&m) {
             Ok(s) => println!("{s}"),
-            Err(e) => return fail(&format!("json: {e}")),
+            Err(e) => return internal("twin", &format!("json: {e}")),
         }
     } else {
         print_summary(&m, &a.out, &stem);
@@ -313,42 +311,50 @@ pub fn default_paper_doc() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../docs/paper-comparison.md")
 }
 
-/// `paper [--json] [--out FILE] [--tolerance TOL]`: run the paper's scenes under both readings
-/// and write docs/paper-comparison.md.
+/// `cargo xtask paper`: the paper's scenes under both readings.
+#[derive(clap::Args, Debug, Clone)]
+pub struct PaperArgs {
+    /// Also print the table as one JSON object.
+    #[arg(long)]
+    pub json: bool,
+    /// Where the page goes.
+    #[arg(long, value_name = "FILE", default_value_os_t = default_paper_doc())]
+    pub out: PathBuf,
+    /// The integrator's tolerance, in (1e-10, 1e-2).
+    #[arg(long, allow_hyphen_values = true, value_parser = args::tolerance, value_name = "TOL", default_value_t = 1e-5)]
+    pub tolerance: f64,
+}
+
+#[derive(Parser)]
+#[command(about = "The paper's scenes under both readings")]
+struct PaperCmd {
+    #[command(flatten)]
+    a: PaperArgs,
+}
+
+/// `paper [--json] [--out FILE] [--tolerance TOL]` from raw arguments: run the paper's scenes
+/// under both readings and write docs/paper-comparison.md.
 pub fn paper_main(args: &[String]) -> i32 {
-    let mut json = false;
-    let mut out = default_paper_doc();
-    let mut tolerance = 1e-5;
-    let mut it = args.iter();
-    while let Some(a) = it.next() {
-        match a.as_str() {
-            "--json" => json = true,
-            "--out" => match it.next() {
-                Some(p) => out = PathBuf::from(p),
-                None => return fail("--out needs a file"),
-            },
-            "--tolerance" => match it.next().and_then(|v| v.parse::<f64>().ok()) {
-                Some(t) if t > 1e-10 && t < 1e-2 => tolerance = t,
-                _ => return fail("--tolerance needs a number in (1e-10, 1e-2)"),
-            },
-            s => {
-                return fail(&format!(
-                    "unknown argument `{s}`; usage: paper [--json] [--out FILE] [--tolerance TOL]"
-                ))
-            }
-        }
+    match args::parse::<PaperCmd>("paper", args) {
+        Ok(c) => paper_run(&c.a),
+        Err(code) => code,
     }
+}
+
+/// `paper` with parsed arguments.
+pub fn paper_run(a: &PaperArgs) -> i32 {
+    let (json, out, tolerance) = (a.json, &a.out, a.tolerance);
     let table = match paper_table::build(tolerance) {
         Ok(t) => t,
-        Err(e) => return fail(&format!("paper scenes: {e}")),
+        Err(e) => return internal("paper", &format!("paper scenes: {e}")),
     };
-    if let Err(e) = std::fs::write(&out, table.markdown()) {
-        return fail(&format!("cannot write {}: {e}", out.display()));
+    if let Err(e) = std::fs::write(out, table.markdown()) {
+        return internal("paper", &format!("cannot write {}: {e}", out.display()));
     }
     if json {
         match serde_json::to_string(&table) {
             Ok(s) => println!("{s}"),
-            Err(e) => return fail(&format!("json: {e}")),
+            Err(e) => return internal("paper", &format!("json: {e}")),
         }
     } else {
         print!("{}", table.markdown());

@@ -2,6 +2,7 @@
 //! only, with two readings (`paper` and `physical`, docs/model.md), an error-controlled stiff
 //! integrator with event location, scenes, sensor traces and metrics.
 
+pub mod args;
 pub mod cli;
 pub mod contact;
 pub mod fault;

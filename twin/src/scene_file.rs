@@ -2,6 +2,7 @@
 //! `deny_unknown_fields`, and the checks that turn them into a [`Scene`], each error naming the
 //! key (`scene.duration_s`, `mechanism.restitution`, `fault[0].severity`).
 
+use crate::args::{num, short};
 use crate::fault::{Fault, FaultKind};
 use crate::reading::Reading;
 use crate::scene::{Scene, SceneError, SceneKind};
@@ -9,11 +10,47 @@ use serde::Deserialize;
 
 /// Parse the text of a scene file.
 pub fn parse(name: &str, text: &str) -> Result<Scene, SceneError> {
-    let raw: RawFile = toml::from_str(text).map_err(|e| SceneError {
-        key: String::new(),
-        message: e.to_string().trim().to_string(),
-    })?;
+    let raw: RawFile = toml::from_str(text).map_err(|e| toml_error(text, &e))?;
     raw.into_scene(name)
+}
+
+/// A TOML syntax or type error named by its `table.key` (found from the error's place in the
+/// text), or by its line when no key is there; the message is cut to a readable length.
+fn toml_error(text: &str, e: &toml::de::Error) -> SceneError {
+    let message = short(e.message().lines().next().unwrap_or("").trim());
+    let Some(at) = e.span().map(|s| s.start.min(text.len())) else {
+        return bad("", message);
+    };
+    let line_no = text.get(..at).map_or(0, |t| t.matches('\n').count());
+    let mut table = String::new();
+    let mut faults = 0;
+    for line in text.lines().take(line_no) {
+        let t = line.trim();
+        if t.starts_with("[[") {
+            table = format!(
+                "{}[{faults}]",
+                t.trim_matches(|c| c == '[' || c == ']').trim()
+            );
+            faults += 1;
+        } else if t.starts_with('[') {
+            table = t.trim_matches(|c| c == '[' || c == ']').trim().to_string();
+        }
+    }
+    let this = text.lines().nth(line_no).unwrap_or("").trim();
+    let key = match this.split_once('=') {
+        Some((k, _)) if !this.starts_with('[') => k.trim().trim_matches('"').to_string(),
+        _ => String::new(),
+    };
+    let place = match (table.is_empty(), key.is_empty()) {
+        (_, true) => table,
+        (true, false) => key,
+        (false, false) => format!("{table}.{key}"),
+    };
+    if place.is_empty() {
+        bad("", format!("line {}: {message}", line_no + 1))
+    } else {
+        bad(&short(&place), format!("{message} (line {})", line_no + 1))
+    }
 }
 
 #[derive(Deserialize)]
@@ -121,7 +158,10 @@ fn bad(key: &str, message: String) -> SceneError {
 fn ranged(target: &mut f64, v: Option<f64>, key: &str, lo: f64, hi: f64) -> Result<(), SceneError> {
     if let Some(v) = v {
         if !(v.is_finite() && v >= lo && v <= hi) {
-            return Err(bad(key, format!("{v} is out of range [{lo}, {hi}]")));
+            return Err(bad(
+                key,
+                format!("{} is out of range [{}, {}]", num(v), num(lo), num(hi)),
+            ));
         }
         *target = v;
     }
@@ -158,14 +198,18 @@ impl RawFile {
                 "scene.kind",
                 format!(
                     "`{}` is not one of reverse_load, forward_load, continuous_closing, hold, drive",
-                    self.scene.kind
+                    short(&self.scene.kind)
                 ),
             )
         })?;
         let reading = match &self.scene.reading {
             None => Reading::Physical,
-            Some(r) => Reading::parse(r)
-                .ok_or_else(|| bad("scene.reading", format!("`{r}` is not paper or physical")))?,
+            Some(r) => Reading::parse(r).ok_or_else(|| {
+                bad(
+                    "scene.reading",
+                    format!("`{}` is not paper or physical", short(r)),
+                )
+            })?,
         };
         let mut s = Scene::builtin(kind, reading);
         s.name = name.to_string();
@@ -201,7 +245,11 @@ impl RawFile {
             if !(r.is_finite() && r >= 0.0 && r <= s.duration_s) {
                 return Err(bad(
                     "scene.release_at_s",
-                    format!("{r} is out of range [0, duration_s = {}]", s.duration_s),
+                    format!(
+                        "{} is out of range [0, duration_s = {}]",
+                        num(r),
+                        num(s.duration_s)
+                    ),
                 ));
             }
             if kind == SceneKind::Hold {
@@ -249,6 +297,22 @@ impl RawFile {
             1,
             20,
         )?;
+        // Static friction below kinetic has no stick–slip switch the integrator can locate: the
+        // run ends in a step-size underflow (docs/decisions.md, Issue 20). Named here, at once.
+        if m.mu_static < m.mu_dynamic {
+            return Err(bad(
+                if raw.mu_static.is_some() {
+                    "mechanism.mu_static"
+                } else {
+                    "mechanism.mu_dynamic"
+                },
+                format!(
+                    "mu_static = {} is below mu_dynamic = {}: static friction must be ≥ kinetic",
+                    num(m.mu_static),
+                    num(m.mu_dynamic)
+                ),
+            ));
+        }
         if m.pack_inner_radius_m >= m.pack_outer_radius_m {
             return Err(bad(
                 "mechanism.pack_inner_radius_m",
@@ -357,7 +421,7 @@ impl RawFile {
             &mut o.axial_smoothing_m_s,
             ro.axial_smoothing_m_s,
             "open.axial_smoothing_m_s",
-            1e-9,
+            1e-6,
             1.0,
         )?;
         ranged(
@@ -393,7 +457,7 @@ impl RawFile {
                     &format!("fault[{i}].kind"),
                     format!(
                         "`{}` is not one of friction_loss, spring_broken, pack_wear, ramp_jam, drag, encoder_stuck, encoder_jump, current_open",
-                        f.kind
+                        short(&f.kind)
                     ),
                 )
             })?;

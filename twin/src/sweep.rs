@@ -17,76 +17,112 @@ use crate::svg::{self, Panel, Series};
 use noback::mechanism::TABLE2;
 use std::path::PathBuf;
 
-fn fail(msg: &str) -> i32 {
-    eprintln!("error: {msg}");
-    crate::cli::EXIT_USAGE
+use crate::args::{self, bad_input};
+use clap::Parser;
+
+fn internal(msg: &str) -> i32 {
+    eprintln!("xtask sweep: error: {msg}");
+    1
 }
 
-/// `sweep ...`.
+/// A clap value parser: the number of values, 2..=200.
+fn steps_arg(s: &str) -> Result<usize, String> {
+    match s.parse::<usize>() {
+        Ok(n) if (2..=200).contains(&n) => Ok(n),
+        _ => Err("expected a whole number in 2..=200".into()),
+    }
+}
+
+/// `cargo xtask sweep`: design sweeps.
+#[derive(clap::Args, Debug, Clone)]
+pub struct SweepArgs {
+    /// `pressing-force` (Figs 23–25) or `PARAM=a..b` (any [mechanism] or [open] key).
+    #[arg(value_name = "pressing-force|PARAM=a..b")]
+    pub what: String,
+    /// Where the CSV and SVG go.
+    #[arg(long, value_name = "DIR", default_value_os_t = default_out_dir())]
+    pub out: PathBuf,
+    /// The built-in scene a parameter sweep runs.
+    #[arg(long, value_parser = crate::cli::scene_kind_arg, default_value = "reverse_load")]
+    pub scene: SceneKind,
+    /// The model reading of a parameter sweep.
+    #[arg(long, value_parser = crate::cli::reading_arg, default_value = "physical")]
+    pub reading: Reading,
+    /// Values in a parameter sweep, 2..=200.
+    #[arg(long, allow_hyphen_values = true, value_parser = steps_arg, default_value_t = 5)]
+    pub steps: usize,
+}
+
+#[derive(Parser)]
+#[command(about = "Design sweeps")]
+struct SweepCmd {
+    #[command(flatten)]
+    a: SweepArgs,
+}
+
+/// `sweep ...` from raw arguments.
 pub fn sweep_main(args: &[String]) -> i32 {
-    let Some(what) = args.first() else {
-        return fail("usage: sweep pressing-force [--out DIR] | sweep PARAM=a..b [--scene S] [--reading R] [--steps N] [--out DIR]");
-    };
-    let mut out = default_out_dir();
-    let mut scene = SceneKind::ReverseLoad;
-    let mut reading = Reading::Physical;
-    let mut steps = 5usize;
-    let mut it = args.iter().skip(1);
-    while let Some(a) = it.next() {
-        let v = it.next();
-        match (a.as_str(), v) {
-            ("--out", Some(v)) => out = PathBuf::from(v),
-            ("--scene", Some(v)) => match SceneKind::parse(v) {
-                Some(k) => scene = k,
-                None => return fail(&format!("--scene `{v}` is not a built-in scene")),
+    match args::parse::<SweepCmd>("sweep", args) {
+        Ok(c) => sweep_run(&c.a),
+        Err(code) => code,
+    }
+}
+
+/// `sweep` with parsed arguments.
+pub fn sweep_run(a: &SweepArgs) -> i32 {
+    let (what, out, scene, reading, steps) = (&a.what, &a.out, a.scene, a.reading, a.steps);
+    // A bad `PARAM=a..b` or key is bad input, found before any output is written.
+    let range = if what == "pressing-force" {
+        None
+    } else {
+        match parse_range(what) {
+            Ok((param, lo, hi)) => match scene_with(scene, reading, &param, lo)
+                .and_then(|_| scene_with(scene, reading, &param, hi))
+            {
+                Ok(_) => Some((param, lo, hi)),
+                Err(e) => return bad_input("sweep", &e),
             },
-            ("--reading", Some(v)) => match Reading::parse(v) {
-                Some(r) => reading = r,
-                None => return fail(&format!("--reading `{v}`: expected paper or physical")),
-            },
-            ("--steps", Some(v)) => match v.parse::<usize>() {
-                Ok(n) if (2..=200).contains(&n) => steps = n,
-                _ => return fail(&format!("--steps `{v}`: expected 2..200")),
-            },
-            (a, _) => return fail(&format!("unknown or incomplete option `{a}`")),
+            Err(e) => return bad_input("sweep", &e),
         }
+    };
+    if let Err(e) = std::fs::create_dir_all(out) {
+        return internal(&format!("cannot create {}: {e}", out.display()));
     }
-    if let Err(e) = std::fs::create_dir_all(&out) {
-        return fail(&format!("cannot create {}: {e}", out.display()));
-    }
-    if what == "pressing-force" {
-        return match pressing_force(&out) {
-            Ok(()) => 0,
-            Err(e) => fail(&e),
-        };
-    }
-    match parse_range(what) {
-        Ok((param, lo, hi)) => match param_sweep(&out, &param, lo, hi, steps, scene, reading) {
-            Ok(()) => 0,
-            Err(e) => fail(&e),
-        },
-        Err(e) => fail(&e),
+    let result = match range {
+        None => pressing_force(out),
+        Some((param, lo, hi)) => param_sweep(out, &param, lo, hi, steps, scene, reading),
+    };
+    match result {
+        Ok(()) => 0,
+        Err(e) => internal(&e),
     }
 }
 
 /// Parse `PARAM=a..b`.
 pub fn parse_range(s: &str) -> Result<(String, f64, f64), String> {
-    let (param, range) = s
-        .split_once('=')
-        .ok_or_else(|| format!("`{s}`: expected pressing-force or PARAM=a..b"))?;
+    let (param, range) = s.split_once('=').ok_or_else(|| {
+        format!(
+            "`{}`: expected pressing-force or PARAM=a..b",
+            args::short(s)
+        )
+    })?;
     let (a, b) = range
         .split_once("..")
-        .ok_or_else(|| format!("`{range}`: expected a..b"))?;
+        .ok_or_else(|| format!("`{}`: expected a..b", args::short(range)))?;
     let lo: f64 = a
         .trim()
         .parse()
-        .map_err(|_| format!("`{a}` is not a number"))?;
+        .map_err(|_| format!("`{}` is not a number", args::short(a)))?;
     let hi: f64 = b
         .trim()
         .parse()
-        .map_err(|_| format!("`{b}` is not a number"))?;
+        .map_err(|_| format!("`{}` is not a number", args::short(b)))?;
     if !(lo.is_finite() && hi.is_finite() && hi > lo) {
-        return Err(format!("range {lo}..{hi} must be finite and increasing"));
+        return Err(format!(
+            "range {}..{} must be finite and increasing",
+            args::num(lo),
+            args::num(hi)
+        ));
     }
     Ok((param.trim().to_string(), lo, hi))
 }
@@ -111,7 +147,10 @@ pub fn scene_with(
             let open = format!("{head}[open]\n{param} = {value:?}\n");
             Scene::from_toml(kind.name(), &open).map_err(|e| {
                 if e.to_string().contains("unknown field") {
-                    format!("`{param}` is neither a [mechanism] nor an [open] key")
+                    format!(
+                        "`{}` is neither a [mechanism] nor an [open] key",
+                        args::short(param)
+                    )
                 } else {
                     e.to_string()
                 }

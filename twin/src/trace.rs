@@ -172,6 +172,8 @@ impl Trace {
             rows: Vec::new(),
         };
         let mut header_seen = false;
+        let mut rate_line = None;
+        let mut header_line = 1;
         for (n, line) in lines {
             let line = line.trim_end();
             if line.is_empty() {
@@ -179,10 +181,19 @@ impl Trace {
             }
             if let Some(meta) = line.strip_prefix('#') {
                 if let Some(v) = meta.trim().strip_prefix("sample_rate_hz=") {
-                    trace.sample_rate_hz = v
-                        .trim()
-                        .parse()
-                        .map_err(|_| parse_err(n, 0, format!("bad sample rate `{v}`")))?;
+                    let rate: f64 = v.trim().parse().unwrap_or(f64::NAN);
+                    if !(rate.is_finite() && rate > 0.0) {
+                        return Err(parse_err(
+                            n,
+                            0,
+                            format!(
+                                "sample_rate_hz must be a positive number, found `{}`",
+                                crate::args::short(v.trim())
+                            ),
+                        ));
+                    }
+                    trace.sample_rate_hz = rate;
+                    rate_line = Some(n);
                 }
                 continue;
             }
@@ -201,17 +212,44 @@ impl Trace {
                     ));
                 }
                 header_seen = true;
+                header_line = n;
                 continue;
             }
-            trace.rows.push(parse_row(n, line)?);
+            let row = parse_row(n, line)?;
+            if let Some(last) = trace.rows.last() {
+                if row.t_s <= last.t_s {
+                    return Err(parse_err(
+                        n,
+                        1,
+                        format!(
+                            "time does not increase: t_s = {} after {}",
+                            crate::args::num(row.t_s),
+                            crate::args::num(last.t_s)
+                        ),
+                    ));
+                }
+            }
+            trace.rows.push(row);
         }
         if !header_seen {
             return Err(parse_err(1, 0, "no column header line"));
         }
-        if trace.sample_rate_hz.is_nan() || trace.sample_rate_hz <= 0.0 {
+        if rate_line.is_none() {
             return Err(parse_err(2, 0, "missing `# sample_rate_hz=` line"));
         }
-        Ok(trace)
+        match trace.rows.len() {
+            0 => Err(parse_err(
+                header_line + 1,
+                0,
+                "no samples after the column header",
+            )),
+            1 => Err(parse_err(
+                header_line + 1,
+                0,
+                "one sample: a trace needs at least two",
+            )),
+            _ => Ok(trace),
+        }
     }
 }
 
@@ -232,7 +270,7 @@ fn parse_row(n: usize, line: &str) -> Result<TraceRow, TraceError> {
                 i + 1,
                 format!(
                     "`{}` is not a number ({})",
-                    field(i),
+                    crate::args::short(field(i)),
                     COLUMNS.get(i).unwrap_or(&"")
                 ),
             )
@@ -250,7 +288,7 @@ fn parse_row(n: usize, line: &str) -> Result<TraceRow, TraceError> {
                 i + 1,
                 format!(
                     "`{}` is not an unsigned integer ({})",
-                    field(i),
+                    crate::args::short(field(i)),
                     COLUMNS.get(i).unwrap_or(&"")
                 ),
             )
@@ -351,5 +389,34 @@ mod tests {
             Err(TraceError::Parse { line, .. }) => assert_eq!(line, 4),
             other => panic!("{other:?}"),
         }
+    }
+
+    #[test]
+    fn a_trace_that_cannot_be_compared_is_refused_naming_why() {
+        let cols = COLUMNS.join(",");
+        let row = |t: &str| format!("{t},2048,0,0,0,0,0,0,0,0,0\n");
+        let text = |rate: &str, rows: &[&str]| {
+            let body: String = rows.iter().map(|t| row(t)).collect();
+            format!("{HEADER}\n{rate}{cols}\n{body}")
+        };
+        let err = |t: String| match Trace::parse(&t) {
+            Err(TraceError::Parse { line, message, .. }) => (line, message),
+            other => panic!("{other:?}"),
+        };
+        let rate = "# sample_rate_hz=10000\n";
+        let (line, m) = err(text(rate, &[]));
+        assert!(line == 4 && m.contains("no samples"), "{m}");
+        let (line, m) = err(text(rate, &["0.0"]));
+        assert!(line == 4 && m.contains("one sample"), "{m}");
+        let (line, m) = err(text(rate, &["0.0", "0.0002", "0.0001"]));
+        assert!(line == 6 && m.contains("time does not increase"), "{m}");
+        let (line, m) = err(text("# sample_rate_hz=0\n", &["0.0", "0.0001"]));
+        assert!(
+            line == 2 && m.contains("sample_rate_hz must be a positive number"),
+            "{m}"
+        );
+        let (_, m) = err(text("", &["0.0", "0.0001"]));
+        assert!(m.contains("missing `# sample_rate_hz=`"), "{m}");
+        assert!(Trace::parse(&text(rate, &["0.0", "0.0001"])).is_ok());
     }
 }

@@ -1,40 +1,57 @@
 //! `cargo xtask fuzz [TARGET|all] [--seconds N]` — the fuzz targets under libFuzzer (cargo-fuzz,
 //! nightly) for as long as asked. Installs cargo-fuzz from crates.io when missing; needs a
-//! nightly toolchain (it says so if there is none). Each run appends its statistics to
-//! `target/fuzz-log.jsonl`, which `cargo xtask reliability` summarises. The same bodies run
-//! briefly on stable in `cargo xtask test` (host-tests/tests/fuzz_brief.rs).
+//! nightly toolchain (it says so if there is none). Each run appends its statistics to the
+//! committed record `fuzz/long-runs.json`, which `cargo xtask reliability` summarises. The same
+//! bodies run briefly on stable in `cargo xtask test` (host-tests/tests/fuzz_brief.rs).
 
 use crate::shell::{self, workspace_root};
 use host_tests::fuzz::TARGETS;
-use serde_json::json;
-use std::io::Write as _;
+use serde_json::{json, Value};
 use std::process::Command;
 
+/// The committed record of long fuzzing runs: a JSON array, one object per run (`target`,
+/// `seconds`, `execs`, `corpus_files`, `crashed`; `runs` when one object sums several).
+pub fn record_path() -> std::path::PathBuf {
+    workspace_root().join("fuzz").join("long-runs.json")
+}
+
+/// The runs recorded so far (none when the file is missing).
+pub fn read_record() -> Result<Vec<Value>, String> {
+    let path = record_path();
+    match std::fs::read_to_string(&path) {
+        Ok(text) => serde_json::from_str(&text).map_err(|e| format!("{}: {e}", path.display())),
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => Ok(Vec::new()),
+        Err(e) => Err(format!("{}: {e}", path.display())),
+    }
+}
+
+/// A clap value parser: a fuzz target or `all`.
+fn target_arg(s: &str) -> Result<String, String> {
+    if s == "all" || TARGETS.contains(&s) {
+        Ok(s.to_string())
+    } else {
+        Err(format!("expected one of {} or all", TARGETS.join(", ")))
+    }
+}
+
+/// `cargo xtask fuzz`'s options.
+#[derive(clap::Args, Debug)]
+pub struct FuzzArgs {
+    /// The fuzz target (default: all).
+    #[arg(value_parser = target_arg, value_name = "TARGET|all")]
+    pub target: Option<String>,
+    /// Seconds per target.
+    #[arg(long, allow_hyphen_values = true, value_parser = clap::value_parser!(u64).range(1..), default_value_t = 60)]
+    pub seconds: u64,
+}
+
 /// Entry.
-pub fn main(args: &[String]) -> Result<i32, String> {
-    let mut targets: Vec<&str> = Vec::new();
-    let mut seconds = 60_u64;
-    let mut it = args.iter();
-    while let Some(arg) = it.next() {
-        match arg.as_str() {
-            "--seconds" => {
-                seconds = it
-                    .next()
-                    .and_then(|v| v.parse().ok())
-                    .filter(|s| *s > 0)
-                    .ok_or("--seconds needs a positive whole number")?;
-            }
-            "all" => targets.extend(TARGETS),
-            t => {
-                targets.push(TARGETS.iter().find(|x| **x == t).ok_or_else(|| {
-                    format!("unknown fuzz target `{t}` (one of {TARGETS:?} or all)")
-                })?)
-            }
-        }
-    }
-    if targets.is_empty() {
-        targets.extend(TARGETS);
-    }
+pub fn main(a: &FuzzArgs) -> Result<i32, String> {
+    let seconds = a.seconds;
+    let targets: Vec<&str> = match a.target.as_deref() {
+        None | Some("all") => TARGETS.to_vec(),
+        Some(t) => TARGETS.iter().copied().filter(|x| *x == t).collect(),
+    };
     let nightly = Command::new("rustup")
         .args(["toolchain", "list"])
         .output()
@@ -90,12 +107,10 @@ pub fn main(args: &[String]) -> Result<i32, String> {
             "crashed": crashed,
         });
         println!("{entry}");
-        let mut f = std::fs::OpenOptions::new()
-            .create(true)
-            .append(true)
-            .open(root.join("target").join("fuzz-log.jsonl"))
-            .map_err(|e| e.to_string())?;
-        writeln!(f, "{entry}").map_err(|e| e.to_string())?;
+        let mut record = read_record()?;
+        record.push(entry);
+        let text = serde_json::to_string_pretty(&record).map_err(|e| e.to_string())? + "\n";
+        std::fs::write(record_path(), text).map_err(|e| e.to_string())?;
         if crashed {
             eprintln!("{log}");
             return Err(format!(

@@ -10,7 +10,7 @@ use crate::shell::workspace_root;
 pub const GOLDEN_SCENES: [&str; 4] = ["reverse_load", "forward_load", "hold", "drive"];
 
 /// Entry.
-pub fn main(_args: &[String]) -> Result<i32, String> {
+pub fn main() -> Result<i32, String> {
     let dir = workspace_root().join("host-tests").join("golden");
     std::fs::create_dir_all(&dir).map_err(|e| format!("{}: {e}", dir.display()))?;
     for scene in GOLDEN_SCENES {

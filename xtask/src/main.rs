@@ -1,7 +1,8 @@
 //! `cargo xtask` — noback's commands. Automation only: no physics lives here.
 //!
-//! Each command is one file; this one parses the command line and dispatches. The README's two
-//! commands are `cargo xtask run` (the main job) and `cargo xtask test` (every test).
+//! Each command is one file; this one parses the command line (clap, by the convention of
+//! `noback_twin::args`: `--help` exits 0, a bad argument exits 2 with one line naming it) and
+//! dispatches. The README's two commands are `cargo xtask run` and `cargo xtask test`.
 
 mod bench;
 mod bootstrap;
@@ -13,6 +14,7 @@ mod golden;
 mod monitor;
 mod monitor_mc;
 mod opt_level;
+mod pages;
 mod qemu;
 mod reliability;
 mod replay;
@@ -24,112 +26,156 @@ mod test;
 mod tidy;
 mod twin_bench;
 
+use clap::{CommandFactory, Parser, Subcommand};
+use cores::Core;
+use noback_twin::args as convention;
 use std::process::ExitCode;
 
-/// Every command, with its one-line help. The tidy test checks the README names only these.
-pub const COMMANDS: &[(&str, &str)] = &[
-    (
-        "run",
-        "[--scene NAME|FILE] [--core m0|m3|m4f] [--json]: the firmware replays a twin scene at 10 kHz under QEMU",
-    ),
-    (
-        "test",
-        "[--core C] [--bless]: every test: fmt, clippy, tidy, host tests, QEMU tests on M0/M3/M4F",
-    ),
-    (
-        "qemu",
-        "ELF [--core m0|m3|m4f] [--timeout S] [--icount SHIFT]: boot an ELF in QEMU, decode defmt (the cargo runner)",
-    ),
-    (
-        "twin",
-        "SCENE|FILE [--reading paper|physical] [--out DIR] [--json]: run the digital twin",
-    ),
-    (
-        "twin-bench",
-        "[--tolerance TOL] [--no-scipy]: twin speed against scipy Radau; writes docs/results/twin-speed.md",
-    ),
-    (
-        "paper",
-        "[--json]: the paper's scenes under both readings; writes docs/paper-comparison.md",
-    ),
-    (
-        "sweep",
-        "pressing-force | PARAM=a..b [--scene S]: design sweeps (CSV + SVG)",
-    ),
-    (
-        "monitor",
-        "SCENE|FILE [--json] [--out DIR]: the monitor against the twin (accuracy, flags, latency)",
-    ),
-    (
-        "monitor-mc",
-        "[--runs N] [--fault-runs K] [--seed S] [--json] [--no-doc] [--power-on-settle S] [--pre-roll S]: detection by Monte Carlo; writes docs/monitor.md",
-    ),
-    (
-        "fuzz",
-        "[TARGET|all] [--seconds N]: the fuzz targets under libFuzzer (nightly, cargo-fuzz)",
-    ),
-    (
-        "golden",
-        "regenerate the golden twin traces in host-tests/golden/",
-    ),
-    (
-        "opt-level",
-        "measure flash and instructions at each opt-level; writes docs/results/opt-level.md",
-    ),
-    (
-        "reliability",
-        "input classes, fuzzing, panic-never proof; writes docs/reliability.md",
-    ),
-    (
-        "bench",
-        "[--quick] [--json]: speed against accuracy; writes docs/results/speed-accuracy.*, stability.*, cheapest-per-scene.md",
-    ),
-    (
-        "bootstrap",
-        "add missing rustup targets and install qemu-system-arm if missing",
-    ),
-];
+/// noback's commands: the README's two are `run` (main job) and `test` (every test).
+#[derive(Parser)]
+#[command(name = "cargo xtask", about, disable_help_subcommand = true)]
+struct Cli {
+    #[command(subcommand)]
+    command: Cmd,
+}
 
-fn usage() -> ExitCode {
-    eprintln!("usage: cargo xtask <command> [args]\n\ncommands:");
-    for (name, help) in COMMANDS {
-        eprintln!("  {name:<10} {help}");
+#[derive(Subcommand)]
+enum Cmd {
+    /// The firmware streams a twin scene's trace at 10 kHz under QEMU and reports.
+    Run(run::RunArgs),
+    /// Every test: fmt, clippy, tidy, host tests, QEMU tests on M0/M3/M4F.
+    Test(test::TestArgs),
+    /// Boot an ELF in QEMU and decode defmt (the cargo runner of the thumb targets).
+    Qemu(qemu::QemuArgs),
+    /// Run the digital twin on one scene.
+    Twin(noback_twin::cli::TwinArgs),
+    /// Twin speed against scipy Radau; writes docs/results/twin-speed.md.
+    TwinBench(TwinBenchArgs),
+    /// The paper's scenes under both readings; writes docs/paper-comparison.md.
+    Paper(noback_twin::cli::PaperArgs),
+    /// Design sweeps (CSV + SVG).
+    Sweep(noback_twin::sweep::SweepArgs),
+    /// The monitor against the twin on one scene or trace (accuracy, flags, latency).
+    Monitor(monitor::MonitorArgs),
+    /// Detection by Monte Carlo; writes docs/monitor.md (its own options: see its --help).
+    #[command(disable_help_flag = true)]
+    MonitorMc(Passthrough),
+    /// The fuzz targets under libFuzzer (nightly, cargo-fuzz); extends fuzz/long-runs.json.
+    Fuzz(fuzz::FuzzArgs),
+    /// Regenerate the golden twin traces in host-tests/golden/.
+    Golden,
+    /// Flash and instructions at each opt-level; writes docs/results/opt-level.md.
+    OptLevel,
+    /// Input classes, fuzzing, panic-never proof; writes docs/reliability.md.
+    Reliability(reliability::ReliabilityArgs),
+    /// Speed against accuracy of model variants; writes docs/results/speed-accuracy.* etc.
+    Bench(BenchArgs),
+    /// Add missing rustup targets and install qemu-system-arm if missing.
+    Bootstrap,
+}
+
+/// Arguments handed whole to a command that parses its own.
+#[derive(clap::Args)]
+struct Passthrough {
+    #[arg(trailing_var_arg = true, allow_hyphen_values = true)]
+    args: Vec<String>,
+}
+
+/// `bench`'s options, checked here; `bench::main` reads the same words.
+#[derive(clap::Args)]
+struct BenchArgs {
+    /// Fewer variants and runs.
+    #[arg(long)]
+    quick: bool,
+    /// Print the results as one JSON object.
+    #[arg(long)]
+    json: bool,
+}
+
+/// `twin-bench`'s options, checked here; `twin_bench::main` reads the same words.
+#[derive(clap::Args)]
+struct TwinBenchArgs {
+    /// The integrators' tolerance, in (1e-10, 1e-2).
+    #[arg(long, allow_hyphen_values = true, value_parser = convention::tolerance, value_name = "TOL")]
+    tolerance: Option<f64>,
+    /// Measure the twin only.
+    #[arg(long)]
+    no_scipy: bool,
+}
+
+/// A clap value parser: a core name.
+pub fn core_arg(s: &str) -> Result<Core, String> {
+    Core::parse(s).map_err(|_| "expected m0, m3 or m4f".into())
+}
+
+/// Every command's name (the tidy test checks the README and docs name only these).
+pub fn command_names() -> Vec<String> {
+    Cli::command()
+        .get_subcommands()
+        .map(|c| c.get_name().to_string())
+        .collect()
+}
+
+/// Parses and runs a command line (without the program name); returns the exit code.
+fn dispatch(args: &[String]) -> i32 {
+    let name = args
+        .first()
+        .filter(|a| !a.starts_with('-'))
+        .map_or("", String::as_str);
+    let known = command_names().iter().any(|c| c == name);
+    let cli = match convention::parse::<Cli>(if known { name } else { "" }, args) {
+        Ok(cli) => cli,
+        Err(code) => return code,
+    };
+    // Bench and twin-bench were checked above; they read their own words from the same list.
+    let rest = args.get(1..).unwrap_or_default();
+    let result = match cli.command {
+        Cmd::Run(a) => run::main(&a),
+        Cmd::Test(a) => test::main(&a),
+        Cmd::Qemu(a) => qemu::main(&a),
+        Cmd::Twin(a) => Ok(noback_twin::cli::twin_run(&a)),
+        Cmd::Paper(a) => Ok(noback_twin::cli::paper_run(&a)),
+        Cmd::Sweep(a) => Ok(noback_twin::sweep::sweep_run(&a)),
+        Cmd::TwinBench(_) => twin_bench::main(rest),
+        Cmd::Monitor(a) => monitor::main(&a),
+        Cmd::MonitorMc(a) => monitor_mc::main(&a.args),
+        Cmd::Fuzz(a) => fuzz::main(&a),
+        Cmd::Golden => golden::main(),
+        Cmd::OptLevel => opt_level::main(),
+        Cmd::Reliability(a) => reliability::main(&a),
+        Cmd::Bench(_) => bench::main(rest),
+        Cmd::Bootstrap => bootstrap::ensure_all().map(|()| 0),
+    };
+    match result {
+        Ok(code) => code,
+        Err(e) => {
+            eprintln!("xtask {name}: error: {}", convention::capped(&e));
+            1
+        }
     }
-    ExitCode::from(2)
 }
 
 fn main() -> ExitCode {
     let args: Vec<String> = std::env::args().skip(1).collect();
-    let Some((command, rest)) = args.split_first() else {
-        return usage();
-    };
-    let result = match command.as_str() {
-        "run" => run::main(rest),
-        "test" => test::main(rest),
-        "qemu" => qemu::main(rest),
-        "twin" => Ok(noback_twin::cli::twin_main(rest)),
-        "paper" => Ok(noback_twin::cli::paper_main(rest)),
-        "twin-bench" => twin_bench::main(rest),
-        "sweep" => Ok(noback_twin::sweep::sweep_main(rest)),
-        "monitor" => monitor::main(rest),
-        "monitor-mc" => monitor_mc::main(rest),
-        "fuzz" => fuzz::main(rest),
-        "golden" => golden::main(rest),
-        "opt-level" => opt_level::main(rest),
-        "reliability" => reliability::main(rest),
-        "bench" => bench::main(rest),
-        "bootstrap" => bootstrap::ensure_all().map(|()| 0),
-        "-h" | "--help" | "help" => return usage(),
-        other => {
-            eprintln!("xtask: unknown command `{other}`");
-            return usage();
-        }
-    };
-    match result {
-        Ok(code) => ExitCode::from(u8::try_from(code).unwrap_or(1)),
-        Err(e) => {
-            eprintln!("xtask {command}: error: {e}");
-            ExitCode::from(1)
-        }
+    let code = dispatch(&args);
+    ExitCode::from(u8::try_from(code).unwrap_or(1))
+}
+
+#[cfg(test)]
+mod tests {
+    #[test]
+    fn help_exits_zero_and_bad_arguments_two() {
+        let words = |s: &str| s.split_whitespace().map(String::from).collect::<Vec<_>>();
+        assert_eq!(super::dispatch(&words("--help")), 0);
+        assert_eq!(super::dispatch(&words("run --help")), 0);
+        assert_eq!(
+            super::dispatch(&words("run --core m7")),
+            noback_twin::args::EXIT_USAGE
+        );
+        assert_eq!(
+            super::dispatch(&words("nonsense")),
+            noback_twin::args::EXIT_USAGE
+        );
+        assert_eq!(super::dispatch(&[]), noback_twin::args::EXIT_USAGE);
     }
 }

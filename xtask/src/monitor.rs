@@ -12,47 +12,48 @@ use noback::monitor::Config;
 use noback_twin::svg::{render, Panel, Series};
 use noback_twin::trace::Trace;
 
-/// Exit code for a bad scene, trace or command line (the twin's tools use the same).
-pub const EXIT_INPUT: i32 = 2;
+use noback_twin::args::bad_input;
+#[cfg(test)]
+use noback_twin::args::EXIT_USAGE as EXIT_INPUT;
 use serde_json::json;
 use std::path::PathBuf;
 
+/// `cargo xtask monitor`'s options.
+#[derive(clap::Args, Debug)]
+pub struct MonitorArgs {
+    /// A built-in scene, a TOML scene file, or a recorded trace (`.csv`, the twin's format).
+    #[arg(value_name = "SCENE|FILE|TRACE.csv")]
+    pub target: String,
+    /// Print the report as one JSON object.
+    #[arg(long)]
+    pub json: bool,
+    /// Where the plot goes.
+    #[arg(long, value_name = "DIR", default_value_os_t = workspace_root().join("target").join("monitor"))]
+    pub out: PathBuf,
+}
+
 /// Entry.
-pub fn main(args: &[String]) -> Result<i32, String> {
-    let mut target = None;
-    let mut json_out = false;
-    let mut out = workspace_root().join("target").join("monitor");
-    let mut it = args.iter();
-    while let Some(arg) = it.next() {
-        match arg.as_str() {
-            "--json" => json_out = true,
-            "--out" => out = PathBuf::from(it.next().ok_or("--out needs a directory")?),
-            s if s.starts_with("--") => return Err(format!("unknown option `{s}`")),
-            s => target = Some(s.to_string()),
-        }
-    }
-    let Some(target) = target else {
-        eprintln!(
-            "error: usage: cargo xtask monitor SCENE|SCENE.toml|TRACE.csv [--json] [--out DIR]"
-        );
-        return Ok(EXIT_INPUT);
-    };
+pub fn main(a: &MonitorArgs) -> Result<i32, String> {
+    let (target, json_out, out) = (a.target.clone(), a.json, a.out.clone());
     // A trace file (the twin's CSV format) is replayed as it is; anything else is a scene.
     let (faults, trace) = if target.ends_with(".csv") {
         match Trace::read(std::path::Path::new(&target)) {
             Ok(trace) => (Vec::new(), trace),
             Err(e) => {
-                eprintln!("error: {target}: {e}");
-                return Ok(EXIT_INPUT);
+                return Ok(bad_input(
+                    "monitor",
+                    &format!("{}: {e}", noback_twin::args::short(&target)),
+                ))
             }
         }
     } else {
         match noback_twin::cli::load_scene(&target, None) {
-            Ok(scene) => (scene.faults.clone(), twin_trace(&target)?),
-            Err(e) => {
-                eprintln!("error: {e}");
-                return Ok(EXIT_INPUT);
-            }
+            // The twin failing on a scene that passed the schema is still the scene's fault.
+            Ok(scene) => match twin_trace(&target) {
+                Ok(trace) => (scene.faults.clone(), trace),
+                Err(e) => return Ok(bad_input("monitor", &e)),
+            },
+            Err(e) => return Ok(bad_input("monitor", &e)),
         }
     };
     let estimates = run_monitor(&trace, Config::default())?;
@@ -72,7 +73,7 @@ pub fn main(args: &[String]) -> Result<i32, String> {
     let flags: Vec<_> = acc
         .flags
         .iter()
-        .map(|f| json!({"flag": f.flag, "t_s": f.t_s}))
+        .map(|f| json!({"flag": f.flag, "t_s": (f.t_s * trace.sample_rate_hz).round() / trace.sample_rate_hz}))
         .collect();
     let report = json!({
         "scene": target,
@@ -171,8 +172,13 @@ mod tests {
 
     #[test]
     fn bad_inputs_exit_with_code_2() {
-        let out = std::env::temp_dir().to_string_lossy().into_owned();
-        let run = |target: &str| main(&[target.to_string(), "--out".into(), out.clone()]);
+        let run = |target: &str| {
+            main(&MonitorArgs {
+                target: target.into(),
+                json: false,
+                out: std::env::temp_dir(),
+            })
+        };
         // Unknown scene name, truncated trace, trace from another version.
         assert_eq!(run("no_such_scene"), Ok(EXIT_INPUT));
         let header = noback_twin::trace::HEADER;
@@ -184,6 +190,5 @@ mod tests {
         assert_eq!(run(&truncated), Ok(EXIT_INPUT));
         let other = write("other.trace.csv", &format!("# noback-trace v9\n{cols}\n"));
         assert_eq!(run(&other), Ok(EXIT_INPUT));
-        assert_eq!(main(&[]), Ok(EXIT_INPUT));
     }
 }

@@ -15,7 +15,7 @@ use std::fmt::Write as _;
 const LEVELS: [&str; 5] = ["1", "2", "3", "s", "z"];
 
 /// Entry: `opt-level` (no arguments).
-pub fn main(_args: &[String]) -> Result<i32, String> {
+pub fn main() -> Result<i32, String> {
     bootstrap::ensure_all()?;
     let replay = workspace_root()
         .join("target")
@@ -44,15 +44,11 @@ pub fn main(_args: &[String]) -> Result<i32, String> {
                 "noback-fw",
                 core,
                 Some(&dir),
-                &[
-                    ("CARGO_PROFILE_RELEASE_OPT_LEVEL", level.as_ref()),
-                    ("NOBACK_REPLAY", replay.as_os_str()),
-                ],
+                &[("CARGO_PROFILE_RELEASE_OPT_LEVEL", level.as_ref())],
             )?;
-            let flash = elf_size::of_file(&elf)?
-                .flash_bytes
-                .saturating_sub(bytes.len() as u64);
-            let out = run::boot(core, &elf, BENCH_SHIFT, vec!["bench".into()], false)?;
+            let flash = elf_size::of_file(&elf)?.flash_bytes;
+            let args = vec!["bench".into(), format!("trace={}", replay.display())];
+            let out = run::boot(core, &elf, BENCH_SHIFT, args, false)?;
             let line = run::line_with(&out.lines, "bench")?;
             let (mean, max) = run::step_insns(&line, core)?;
             if core == Core::M3 && m3_best.is_none_or(|(_, best)| mean < best) {

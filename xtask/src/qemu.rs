@@ -150,46 +150,57 @@ fn forward_stderr(stderr: std::process::ChildStderr) {
     }
 }
 
-/// The runner entry: `qemu ELF [--core C] [--timeout S] [test-args…]`.
-pub fn main(args: &[String]) -> Result<i32, String> {
-    let mut elf = None;
-    let mut core = None;
-    let mut timeout = 60.0_f64;
-    let mut extra = Vec::new();
-    let mut it = args.iter();
-    while let Some(arg) = it.next() {
-        match arg.as_str() {
-            "--core" => core = Some(Core::parse(it.next().ok_or("--core needs a value")?)?),
-            "--icount" => {
-                let shift: u32 = it
-                    .next()
-                    .and_then(|v| v.parse().ok())
-                    .filter(|s| *s <= 10)
-                    .ok_or("--icount needs a shift 0..=10")?;
-                extra = icount(shift);
-            }
-            "--timeout" => {
-                timeout = it
-                    .next()
-                    .and_then(|v| v.parse().ok())
-                    .filter(|t: &f64| *t > 0.0)
-                    .ok_or("--timeout needs a positive number of seconds")?;
-            }
-            // cargo passes test-harness arguments after the ELF; defmt-test takes none.
-            other if elf.is_none() && !other.starts_with('-') => elf = Some(other.to_string()),
-            _ => {}
-        }
+/// A clap value parser: a positive, finite number of seconds.
+fn positive_seconds(s: &str) -> Result<f64, String> {
+    match noback_twin::args::finite(s)? {
+        t if t > 0.0 => Ok(t),
+        _ => Err("must be > 0".into()),
     }
-    let elf =
-        elf.ok_or("usage: cargo xtask qemu ELF [--core m0|m3|m4f] [--timeout S] [--icount SHIFT]")?;
-    let core = core
-        .or_else(|| Core::from_path(&elf))
-        .ok_or_else(|| format!("cannot tell the core from `{elf}`: pass --core m0|m3|m4f"))?;
+}
+
+/// `cargo xtask qemu`'s options (it is the cargo runner: cargo appends test-harness arguments
+/// after the ELF, which defmt-test does not take).
+#[derive(clap::Args, Debug)]
+pub struct QemuArgs {
+    /// The image to boot.
+    pub elf: String,
+    /// The emulated core (default: from the target triple in the ELF's path).
+    #[arg(long, value_parser = crate::core_arg, value_name = "m0|m3|m4f")]
+    pub core: Option<Core>,
+    /// Wall-clock limit in seconds; a run past it ends with exit 124.
+    #[arg(long, allow_hyphen_values = true, value_parser = positive_seconds, default_value_t = 60.0, value_name = "S")]
+    pub timeout: f64,
+    /// Count instructions: 2^SHIFT ns of virtual time each, 0..=10.
+    #[arg(long, allow_hyphen_values = true, value_parser = clap::value_parser!(u32).range(0..=10), value_name = "SHIFT")]
+    pub icount: Option<u32>,
+    /// Test-harness arguments cargo passes after the ELF (ignored).
+    #[arg(trailing_var_arg = true, allow_hyphen_values = true, hide = true)]
+    pub harness: Vec<String>,
+}
+
+/// The runner entry.
+pub fn main(a: &QemuArgs) -> Result<i32, String> {
+    let core = a.core.or_else(|| Core::from_path(&a.elf));
+    let Some(core) = core else {
+        return Ok(noback_twin::args::bad_input(
+            "qemu",
+            &format!(
+                "cannot tell the core from `{}`: pass --core m0|m3|m4f",
+                noback_twin::args::short(&a.elf)
+            ),
+        ));
+    };
+    if !std::path::Path::new(&a.elf).is_file() {
+        return Ok(noback_twin::args::bad_input(
+            "qemu",
+            &format!("`{}` is not a file", noback_twin::args::short(&a.elf)),
+        ));
+    }
     let outcome = boot(&Boot {
-        elf: &elf,
+        elf: &a.elf,
         core,
-        timeout: Duration::from_secs_f64(timeout),
-        extra,
+        timeout: Duration::from_secs_f64(a.timeout),
+        extra: a.icount.map(icount).unwrap_or_default(),
         echo: true,
         args: Vec::new(),
     })?;

@@ -1,7 +1,8 @@
 //! `cargo xtask reliability` — writes `docs/reliability.md` from runs made now: the monitor's
 //! input classes (`host_tests::robustness`), the brief fuzz campaigns (`host_tests::fuzz`), the
-//! panic-never link proof, and the long fuzzing recorded on this machine by `cargo xtask fuzz`
-//! (`target/fuzz-log.jsonl`). Nothing in the page is typed by hand.
+//! panic-never link proof, and the long fuzzing recorded by `cargo xtask fuzz` in the committed
+//! `fuzz/long-runs.json`. Nothing in the page is typed by hand; an unchanged tree gives the same
+//! bytes.
 
 use crate::shell::{self, cargo, workspace_root};
 use host_tests::fuzz::{brief_campaign, TARGETS};
@@ -25,12 +26,20 @@ fn seeds(target: &str) -> Result<Vec<Vec<u8>>, String> {
         .collect()
 }
 
+/// `cargo xtask reliability`'s options.
+#[derive(clap::Args, Debug)]
+pub struct ReliabilityArgs {
+    /// Where the page goes.
+    #[arg(long, value_name = "FILE", default_value_os_t = workspace_root().join("docs").join("reliability.md"))]
+    pub out: std::path::PathBuf,
+}
+
 /// Entry.
-pub fn main(_args: &[String]) -> Result<i32, String> {
+pub fn main(a: &ReliabilityArgs) -> Result<i32, String> {
     let mut doc = String::from(
         "# Reliability: what was tried and what happened\n\n\
          Written by `cargo xtask reliability`; do not edit. Every figure comes from runs made by \
-         that command (or, for long fuzzing, by `cargo xtask fuzz` on the machine that wrote it).\n\n",
+         that command (for long fuzzing, from the record `fuzz/long-runs.json` that `cargo xtask fuzz` extends).\n\n",
     );
     let mut ok = true;
 
@@ -79,17 +88,9 @@ pub fn main(_args: &[String]) -> Result<i32, String> {
         doc,
         "\n### Long runs under libFuzzer (`cargo xtask fuzz`)\n"
     );
-    let log = std::fs::read_to_string(workspace_root().join("target").join("fuzz-log.jsonl"))
-        .unwrap_or_default();
-    let entries: Vec<serde_json::Value> = log
-        .lines()
-        .filter_map(|l| serde_json::from_str(l).ok())
-        .collect();
+    let entries = crate::fuzz::read_record()?;
     if entries.is_empty() {
-        let _ = writeln!(
-            doc,
-            "No long run is recorded on the machine that wrote this page."
-        );
+        let _ = writeln!(doc, "No long run is recorded in `fuzz/long-runs.json`.");
     } else {
         let _ = writeln!(doc, "| target | runs | seconds in all | executions | corpus files (last) | crashes |\n|---|---|---|---|---|---|");
         for target in TARGETS {
@@ -98,6 +99,7 @@ pub fn main(_args: &[String]) -> Result<i32, String> {
             if runs.is_empty() {
                 continue;
             }
+            let count: u64 = runs.iter().map(|e| e["runs"].as_u64().unwrap_or(1)).sum();
             let secs: u64 = runs.iter().filter_map(|e| e["seconds"].as_u64()).sum();
             let execs: u64 = runs.iter().filter_map(|e| e["execs"].as_u64()).sum();
             let corpus = runs
@@ -108,8 +110,7 @@ pub fn main(_args: &[String]) -> Result<i32, String> {
             ok &= crashes == 0;
             let _ = writeln!(
                 doc,
-                "| {target} | {} | {secs} ({:.2} h) | {execs} | {corpus} | {crashes} |",
-                runs.len(),
+                "| {target} | {count} | {secs} ({:.2} h) | {execs} | {corpus} | {crashes} |",
                 secs as f64 / 3600.0
             );
         }
@@ -143,10 +144,10 @@ pub fn main(_args: &[String]) -> Result<i32, String> {
     }
     let _ = writeln!(doc, "\n## No panic path in the real-time code, checked by the linker\n\n`panic-check/` is an image that calls `Monitor::new`, `Monitor::step` and the firmware's `Ticker::tick` (sample, step, alarm pin, event log, digest) on inputs the optimiser cannot see (`core::hint::black_box`), with a panic handler that calls a function that does not exist. Any panic path that survives optimisation — an `unwrap`, a slice index, an overflow check, a `clamp` with bounds the compiler cannot order, a float conversion that panics on NaN — makes the release build fail to link, naming this check. `cargo xtask test` builds it for every core. Result now:\n\n- {}\n\nIt found four real panic paths when first introduced (a `clamp` on a capacity that could go negative, `from_num` conversions that panic on overflow or NaN in the constructor); each was removed at its source.", proof.join("\n- "));
 
-    let _ = writeln!(doc, "\n## Faults, load and nothing lost\n\n- Flags latch until `Monitor::reset_flags` (invariant above, on every step of every class and fuzz input).\n- A missed deadline is counted, logged and raised as `overrun`; the replay skips the missed samples so the model stays in time (`cargo xtask test`, stage \"provoked overrun\": one overrun, flag on the expected tick, firmware still bit-exact with the host).\n- The interrupt never logs: it pushes events into a fixed ring buffer (`noback::event_log`) that counts every event it overwrites; the firmware's summary reports the count, the main loop drains the rest.\n- A panic, a HardFault and a hang on target each end the run with their own exit code (101, 102, 124: the fault probes of `cargo xtask test`).\n- Power-on detection and fault detection by Monte Carlo: see `monitor.md` (`cargo xtask monitor-mc`).\n- Tools: malformed scene files, unknown keys, out-of-range or NaN parameters, non-positive inertias answer with the key and exit code 2 (twin tests); a trace names the line and column, a replay the byte offset (tests in `twin/` and `src/replay.rs`).\n\nAll results as expected: **{}**.", if ok { "yes" } else { "no" });
+    let _ = writeln!(doc, "\n## Faults, load and nothing lost\n\n- Flags latch until `Monitor::reset_flags` (invariant above, on every step of every class and fuzz input).\n- A missed deadline is counted, logged and raised as `overrun`; the replay skips the missed samples so the model stays in time (`cargo xtask test`, stage \"provoked overrun\": one overrun, flag on the expected tick, firmware still bit-exact with the host).\n- The interrupt never logs: it pushes events into a fixed ring buffer (`noback::event_log`) that counts every event it overwrites; the firmware's summary reports the count, the main loop drains the rest.\n- A panic, a HardFault and a hang on target each end the run with their own exit code (101, 102, 124: the fault probes of `cargo xtask test`).\n- Power-on detection and fault detection by Monte Carlo: see `monitor.md` (`cargo xtask monitor-mc`).\n- Tools: every command answers a bad flag, value or extra argument, a bad scene file (unknown keys, out-of-range or NaN values, TOML syntax and type errors by `table.key`, parameter combinations the twin cannot integrate) and a bad trace (empty, one sample, time not increasing, no or zero rate) with exit code 2 and one line naming it, values cut to 80 characters (`xtask/tests/cli_contract.rs`); a trace names the line and column, a replay the byte offset (tests in `twin/` and `src/replay.rs`).\n\nAll results as expected: **{}**.", if ok { "yes" } else { "no" });
 
-    let path = workspace_root().join("docs").join("reliability.md");
-    std::fs::write(&path, doc).map_err(|e| format!("{}: {e}", path.display()))?;
+    let path = &a.out;
+    std::fs::write(path, doc).map_err(|e| format!("{}: {e}", path.display()))?;
     eprintln!("wrote {}", path.display());
     Ok(if ok { 0 } else { 1 })
 }

@@ -26,41 +26,21 @@ pub const REALTIME_SHIFT: u32 = 4;
 /// Bench boot: 2^10 ns per instruction, 12.8 (M0/M3) or 25.6 (M4F) SysTick ticks each.
 pub const BENCH_SHIFT: u32 = 10;
 
-struct Args {
-    scene: String,
-    core: Core,
-    json: bool,
-    overrun_at: Option<u32>,
-}
-
-fn parse(args: &[String]) -> Result<Args, String> {
-    let mut a = Args {
-        scene: "reverse_load".into(),
-        core: Core::M3,
-        json: false,
-        overrun_at: None,
-    };
-    let mut it = args.iter();
-    while let Some(arg) = it.next() {
-        match arg.as_str() {
-            "--core" => a.core = Core::parse(it.next().ok_or("--core needs a value")?)?,
-            "--scene" => a.scene = it.next().ok_or("--scene needs a name or file")?.clone(),
-            "--json" => a.json = true,
-            "--overrun-at" => {
-                a.overrun_at = Some(
-                    it.next()
-                        .and_then(|v| v.parse().ok())
-                        .ok_or("--overrun-at needs a tick number")?,
-                );
-            }
-            other => {
-                return Err(format!(
-                    "unknown argument `{other}` (run [--scene NAME|FILE|stress] [--core m0|m3|m4f] [--json] [--overrun-at TICK])"
-                ))
-            }
-        }
-    }
-    Ok(a)
+/// `cargo xtask run`'s options.
+#[derive(clap::Args, Debug)]
+pub struct RunArgs {
+    /// A built-in scene, a TOML scene file, or `stress` (synthetic hostile inputs).
+    #[arg(long, value_name = "NAME|FILE|stress", default_value = "reverse_load")]
+    pub scene: String,
+    /// The emulated core.
+    #[arg(long, value_parser = crate::core_arg, default_value = "m3", value_name = "m0|m3|m4f")]
+    pub core: Core,
+    /// Print the summary as one JSON object.
+    #[arg(long)]
+    pub json: bool,
+    /// Burn time in this tick to provoke a missed deadline (the overrun test).
+    #[arg(long, value_name = "TICK", allow_hyphen_values = true)]
+    pub overrun_at: Option<u32>,
 }
 
 /// `key=value` fields of a decoded log line.
@@ -119,11 +99,21 @@ fn flag_names(bits: u8) -> Vec<&'static str> {
 }
 
 /// Entry.
-pub fn main(args: &[String]) -> Result<i32, String> {
-    let a = parse(args)?;
+pub fn main(a: &RunArgs) -> Result<i32, String> {
+    // A bad scene (no such name or file, a bad value in the file, a parameter combination the
+    // twin cannot integrate) is bad input: exit 2 before anything is built.
+    if a.scene != STRESS {
+        if let Err(e) = noback_twin::cli::load_scene(&a.scene, None) {
+            return Ok(noback_twin::args::bad_input("run", &e));
+        }
+    }
     bootstrap::ensure_all()?;
     let reset_every = (a.scene == STRESS).then_some(STRESS_RESET_EVERY);
-    let (report, ok) = replay_report(&a.scene, a.core, a.overrun_at, reset_every, !a.json)?;
+    let (report, ok) = match replay_report(&a.scene, a.core, a.overrun_at, reset_every, !a.json) {
+        // The twin failing on a scene that passed the schema is still the scene's fault.
+        Err(e) if e.starts_with("twin: ") => return Ok(noback_twin::args::bad_input("run", &e)),
+        other => other?,
+    };
     if a.json {
         println!("{report}");
     } else {
@@ -166,8 +156,9 @@ pub fn replay_report(
         );
     }
 
-    let elf = build(core, &replay_path)?;
-    let mut rt_args = vec!["realtime".to_string()];
+    let elf = build(core)?;
+    let trace_arg = format!("trace={}", replay_path.display());
+    let mut rt_args = vec!["realtime".to_string(), trace_arg.clone()];
     if let Some(n) = overrun_at {
         rt_args.push(format!("overrun-at={n}"));
     }
@@ -175,7 +166,13 @@ pub fn replay_report(
         rt_args.push(format!("reset-every={n}"));
     }
     let realtime = boot(core, &elf, REALTIME_SHIFT, rt_args, echo)?;
-    let bench = boot(core, &elf, BENCH_SHIFT, vec!["bench".into()], false)?;
+    let bench = boot(
+        core,
+        &elf,
+        BENCH_SHIFT,
+        vec!["bench".into(), trace_arg],
+        false,
+    )?;
 
     let summary = line_with(&realtime.lines, "summary")?;
     let bench_line = line_with(&bench.lines, "bench")?;
@@ -209,11 +206,15 @@ pub fn replay_report(
         );
     }
     let size = elf_size::of_file(&elf)?;
-    let flash_bytes = size.flash_bytes.saturating_sub(bytes.len() as u64);
+    let flash_bytes = size.flash_bytes;
+    let starved = field::<u32>(&summary, "starved")? + field::<u32>(&bench_line, "starved")?;
     let stack_bytes: u32 = field(&summary, "stack_bytes")?;
     let isr_ticks_max: f64 = field::<u32>(&summary, "isr_ticks_max")?.into();
     let period_ticks: f64 = field::<u32>(&summary, "period_ticks")?.into();
 
+    // One time base: a flag raised on tick `n` was raised on the trace's sample `n − 1`, at
+    // its time (what `monitor` reports).
+    let rate = trace.sample_rate_hz;
     let flags: Vec<_> =
         realtime
             .lines
@@ -225,14 +226,15 @@ pub fn replay_report(
                 let before = hex(&f, "before").ok()? as u8;
                 let now = hex(&f, "now").ok()? as u8;
                 Some(flag_names(now & !before).into_iter().map(
-                    move |name| json!({"flag": name, "tick": tick, "t_s": f64::from(tick) / 1e4}),
+                    move |name| json!({"flag": name, "tick": tick, "t_s": f64::from(tick.saturating_sub(1)) / rate}),
                 ))
             })
             .flatten()
             .collect();
 
     // The estimate against the twin's truth every 0.1 s, from the host run (bit-identical to
-    // the firmware's when bit_exact holds).
+    // the firmware's when bit_exact holds). Braking torque as a magnitude, the trace's
+    // convention (the monitor's own field is signed, opposing the output's motion).
     let moments: Vec<_> = host
         .estimates
         .iter()
@@ -240,12 +242,12 @@ pub fn replay_report(
         .step_by(1000)
         .map(|(e, row)| {
             json!({
-                "t_s": row.t_s,
+                "t_s": (row.t_s * rate).round() / rate,
                 "scene": format!("{:?}", e.scene),
                 "brake": format!("{:?}", e.brake),
                 "pressing_force_n": e.pressing_force_n.to_num::<f64>(),
                 "twin_pressing_force_n": row.pressing_force_n,
-                "braking_torque_nm": e.braking_torque_nm.to_num::<f64>(),
+                "braking_torque_nm": e.braking_torque_nm.to_num::<f64>().abs(),
                 "twin_braking_torque_nm": row.braking_torque_nm,
             })
         })
@@ -258,6 +260,7 @@ pub fn replay_report(
         "ticks": ticks,
         "overruns": field::<u32>(&summary, "overruns")?,
         "missed_ticks": field::<u32>(&summary, "missed")?,
+        "stream_starved_ticks": starved,
         "log_overwritten": field::<u32>(&summary, "log_overwritten")?,
         "flags": flags,
         "insns_per_step_mean": (insns_mean * 10.0).round() / 10.0,
@@ -275,15 +278,19 @@ pub fn replay_report(
         "host_digest": format!("{:#010x}", host.totals.digest),
         "key_moments": moments,
     });
-    let ok = realtime.code == 0 && bench.code == 0 && bit_exact;
+    let ok = realtime.code == 0 && bench.code == 0 && bit_exact && starved == 0;
     Ok((report, ok))
 }
 
 fn print_summary(r: &serde_json::Value) {
     println!("\n=== summary ({} on {}) ===", r["scene"], r["core"]);
     println!(
-        "ticks {}  overruns {} (missed ticks {})  log events overwritten {}",
-        r["ticks"], r["overruns"], r["missed_ticks"], r["log_overwritten"]
+        "ticks {}  overruns {} (missed ticks {})  stream starved {}  log events overwritten {}",
+        r["ticks"],
+        r["overruns"],
+        r["missed_ticks"],
+        r["stream_starved_ticks"],
+        r["log_overwritten"]
     );
     let flags = r["flags"].as_array().cloned().unwrap_or_default();
     if flags.is_empty() {
@@ -304,7 +311,7 @@ fn print_summary(r: &serde_json::Value) {
         r["isr_insns_max"], r["deadline_used_pct"]
     );
     println!(
-        "flash {} B (+ {} B replay data), static RAM {} B, stack high-water {} B",
+        "flash {} B (replay streamed from the host: {} B), static RAM {} B, stack high-water {} B",
         r["flash_bytes"], r["replay_bytes"], r["ram_bytes"], r["stack_bytes_max"]
     );
     println!("     t_s  scene          brake      force N  (twin)   torque N·m (twin)");
@@ -326,14 +333,10 @@ fn print_summary(r: &serde_json::Value) {
     );
 }
 
-/// Builds the firmware for `core` in release with `replay` embedded; returns the ELF path.
-pub fn build(core: Core, replay: &std::path::Path) -> Result<String, String> {
-    build_bin(
-        "noback-fw",
-        core,
-        None,
-        &[("NOBACK_REPLAY", replay.as_os_str())],
-    )
+/// Builds the firmware for `core` in release; returns the ELF path. It streams its trace from
+/// the file named by its `trace=FILE` argument.
+pub fn build(core: Core) -> Result<String, String> {
+    build_bin("noback-fw", core, None, &[])
 }
 
 /// Builds a target binary of the `noback` package in release for `core` (into `target_dir`,

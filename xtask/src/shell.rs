@@ -79,3 +79,15 @@ pub fn built_executables(cmd: &mut Command) -> Result<Vec<(String, String)>, Err
     }
     Ok(found)
 }
+
+/// This xtask's executable, to run it again. `cargo test --workspace` (a stage of `xtask test`)
+/// relinks `target/debug/xtask` for the command-line tests, after which Linux names the running
+/// image `… (deleted)`; the file now at its path is built from the same sources.
+pub fn this_exe() -> Result<PathBuf, Error> {
+    let exe = std::env::current_exe().map_err(|e| format!("this executable: {e}"))?;
+    let name = exe.to_string_lossy();
+    Ok(match name.strip_suffix(" (deleted)") {
+        Some(path) => PathBuf::from(path),
+        None => exe,
+    })
+}

@@ -15,19 +15,21 @@ use std::time::{Duration, Instant};
 /// The scene whose QEMU run is the snapshot test: the paper's reverse-load motor failure.
 pub const SNAPSHOT_SCENE: &str = "reverse_load";
 
-/// Entry: `test [--core m0|m3|m4f]… [--bless]` (default: all three cores; `--bless` rewrites
-/// the QEMU snapshot instead of comparing with it).
-pub fn main(args: &[String]) -> Result<i32, String> {
-    let mut cores = Vec::new();
-    let mut bless = false;
-    let mut it = args.iter();
-    while let Some(arg) = it.next() {
-        match arg.as_str() {
-            "--bless" => bless = true,
-            "--core" => cores.push(Core::parse(it.next().ok_or("--core needs a value")?)?),
-            other => return Err(format!("unknown argument `{other}` (try --core m0|m3|m4f)")),
-        }
-    }
+/// `cargo xtask test`'s options.
+#[derive(clap::Args, Debug)]
+pub struct TestArgs {
+    /// Test only these cores under QEMU (repeatable; default: all three).
+    #[arg(long, value_parser = crate::core_arg, value_name = "m0|m3|m4f")]
+    pub core: Vec<Core>,
+    /// Rewrite the QEMU snapshot instead of comparing with it.
+    #[arg(long)]
+    pub bless: bool,
+}
+
+/// Entry.
+pub fn main(a: &TestArgs) -> Result<i32, String> {
+    let mut cores = a.core.clone();
+    let bless = a.bless;
     if cores.is_empty() {
         cores = Core::ALL.to_vec();
     }
@@ -84,6 +86,8 @@ pub fn main(args: &[String]) -> Result<i32, String> {
     }
     section("host tests (library, host-tests, twin, xtask tidy)");
     shell::run(cargo().args(["test", "--workspace"]))?;
+    section("pages reproduce (reliability against its committed page, paper and monitor-mc twice)");
+    crate::pages::reproduce()?;
 
     let host_digest = noback::vectors::run().digest;
     let mut rows = Vec::new();
@@ -118,6 +122,8 @@ pub fn main(args: &[String]) -> Result<i32, String> {
             overrun_is_counted_and_flagged()?;
             section("load: hostile inputs, flags reset every 50 ticks (m3)");
             stress_stays_within_its_deadline()?;
+            section("one time base: a flag's time from run equals monitor's (m3)");
+            run_and_monitor_agree_on_time()?;
         }
         let fw_digest = u32::from_str_radix(
             report["fx_selfcheck_digest"]
@@ -159,7 +165,7 @@ fn section(title: &str) {
 /// Runs the defmt-test target tests for `core` under QEMU (this xtask as the cargo runner),
 /// echoing and returning their output lines.
 fn target_tests(core: Core) -> Result<Vec<String>, String> {
-    let exe = std::env::current_exe().map_err(|e| e.to_string())?;
+    let exe = crate::shell::this_exe()?;
     let runner_var = format!(
         "CARGO_TARGET_{}_RUNNER",
         core.triple().to_uppercase().replace('-', "_")
@@ -257,6 +263,49 @@ fn stress_stays_within_its_deadline() -> Result<(), String> {
             "the load test missed its deadline, lost bit-exactness or did not load the flag path"
                 .into(),
         )
+    }
+}
+
+/// A fault scene through the firmware and through `monitor`'s comparison on the host: each flag
+/// must carry the same time (the trace's sample time) in both reports.
+fn run_and_monitor_agree_on_time() -> Result<(), String> {
+    let dir = crate::shell::workspace_root().join("target").join("replay");
+    std::fs::create_dir_all(&dir).map_err(|e| e.to_string())?;
+    let scene = dir.join("time_base.toml");
+    let text = "[scene]\nkind = \"reverse_load\"\n[[fault]]\nkind = \"encoder_stuck\"\nat_s = 0.1\nseverity = 1.0\n";
+    std::fs::write(&scene, text).map_err(|e| e.to_string())?;
+    let scene = scene.to_string_lossy().into_owned();
+    let (report, ok) = run::replay_report(&scene, Core::M3, None, None, false)?;
+    let trace = crate::replay::twin_trace(&scene)?;
+    let estimates = host_tests::accuracy::run_monitor(&trace, noback::monitor::Config::default())?;
+    let host = host_tests::accuracy::compare(&trace, &estimates);
+    let run_flags: Vec<(String, f64)> = report["flags"]
+        .as_array()
+        .into_iter()
+        .flatten()
+        .map(|f| {
+            (
+                f["flag"].as_str().unwrap_or("").to_string(),
+                f["t_s"].as_f64().unwrap_or(f64::NAN),
+            )
+        })
+        .collect();
+    let monitor_flags: Vec<(String, f64)> = host
+        .flags
+        .iter()
+        .map(|f| (f.flag.to_string(), f.t_s))
+        .collect();
+    println!("run: {run_flags:?}\nmonitor: {monitor_flags:?}");
+    let agree = !run_flags.is_empty()
+        && run_flags.len() == monitor_flags.len()
+        && run_flags
+            .iter()
+            .zip(&monitor_flags)
+            .all(|(a, b)| a.0 == b.0 && (a.1 - b.1).abs() < 0.5 / trace.sample_rate_hz);
+    if ok && agree {
+        Ok(())
+    } else {
+        Err("run and monitor report different flags or times on the same scene".into())
     }
 }
 
