@@ -6,8 +6,7 @@
 //! reset (docs/monitor-design.md, "A change of reading waits for the step check").
 //!
 //! They live out of line (`#[inline(never)]`): the drive-off ticks — braking and holding, the
-//! monitor's worst case — then do not carry their registers (measured: +22 instructions on
-//! every tick they are not run on when inlined, `cargo xtask run --json`).
+//! monitor's worst case — then do not carry their registers (docs/decisions.md).
 //!
 //! | quantity | format | range | resolution |
 //! |---|---|---|---|
