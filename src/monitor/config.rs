@@ -186,7 +186,7 @@ impl Thresholds {
         max_lost_motion_rad: 0.2, // the twin's lost motion is 0.03–0.1 rad
         current_off_max_a: 3.0,
         adc_rail_time_s: 0.01, // overrunning chatter stalls the motor at the current limit ≈ 3 ms
-        dead_current_nm: 0.5,  // healthy ≥ 1.37 N·m; a dead reading's noise ≤ 0.06 N·m
+        dead_current_nm: 0.5,  // healthy ≥ 1.42 N·m; a dead reading's noise ≈ 0.13 N·m
         dead_current_speed_rad_s: 2.0,
         health_rate_per_s: 25.0,
         impact_time_s: 0.01,
