@@ -322,7 +322,7 @@ impl State {
             },
         );
         self.energy
-            .update(&k.estimate, pe.braking_torque, o.w, !locked);
+            .update(&k.estimate, self.tick, pe.braking_torque, o.w, !locked);
         self.estimate = Estimate {
             scene: c.scene,
             brake: if locked {

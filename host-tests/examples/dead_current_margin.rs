@@ -7,7 +7,7 @@
 //! the monitor's first 0.06 s.
 //!
 //! `cargo run --release -p host-tests --example dead_current_margin -- [RUNS] [SEED]`
-//! (defaults 2000 and 2026). docs/monitor-design.md, "A dead current reading", quotes it.
+//! (defaults 2000 and 2026). docs/decisions.md, "Dead current reading check", quotes it.
 
 use host_tests::mc::{draw, draw_trace};
 use noback::monitor::Config;

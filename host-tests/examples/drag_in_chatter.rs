@@ -1,5 +1,5 @@
 //! What a pack drag changes in continuous closing's chatter, where the monitor misses it
-//! (docs/monitor-design.md, "Where the misses fall"): for each drag draw of the Monte Carlo
+//! (docs/decisions.md, "Where the misses fall"): for each drag draw of the Monte Carlo
 //! that the shipped monitor misses in continuous closing, the same draw without the fault is
 //! run too, and the twin's truths are compared over the 50 ms after the onset — the mean drive
 //! torque, the mean pack torque, the share of the time the pack is locked, the output's mean

@@ -271,7 +271,7 @@ pub fn draw_trace_after(d: &Draw, pre_roll_s: f64) -> Result<Trace, String> {
 
 /// What a campaign runs the draws with: the monitor's configuration and the pre-roll (the
 /// defaults are the shipped monitor and [`PRE_ROLL_S`]; others serve the ablations in
-/// docs/monitor-design.md, `cargo xtask monitor-mc --power-on-settle S --pre-roll S`).
+/// docs/decisions.md, `cargo xtask monitor-mc --power-on-settle S --pre-roll S`).
 #[derive(Clone, Copy, Debug)]
 pub struct Campaign {
     /// The monitor's configuration.

@@ -99,8 +99,7 @@ pub struct Thresholds {
     /// low-pass at `step_reference_hz`): a pack that starts to drag (the drive pushes harder:
     /// `brake_drag`) or a current reading that loses gain (`sensor_fault`). Genuine load
     /// changes are slower than the history follows: a ramp lags the 5 Hz history by
-    /// `rate/(2π·5 Hz)`, so 1.25 N·m lets door loads change at up to 39 N·m/s (the Monte Carlo's
-    /// first false alarms come at 0.25 N·m).
+    /// `rate/(2π·5 Hz)`, so 1.25 N·m lets door loads change at up to 39 N·m/s.
     pub step_allowance_nm: f64,
     /// Corner frequency of the implied load's recent history (Hz).
     pub step_reference_hz: f64,
@@ -139,8 +138,8 @@ pub struct Thresholds {
     /// reading is dead while the drive is on, the output turns and the pack has lately held it
     /// (`sensor_fault`; `monitor/dead_current.rs`). Must lie below the pack's spring drag
     /// while driving (1.98 N·m with Table 2), around which a moving no-back's drive torque
-    /// sits at its lowest: healthy drives average ≥ 1.42 N·m over the blocks the check judges
-    /// in the Monte Carlo (`cargo run --release -p host-tests --example dead_current_margin`).
+    /// sits at its lowest (the healthy margin: `cargo run --release -p host-tests --example
+    /// dead_current_margin`).
     pub dead_current_nm: f64,
     /// The output counts as turning for the dead-reading check above this mean speed over the
     /// block (rad/s).
@@ -164,7 +163,7 @@ impl Thresholds {
         lock_dwell_s: 0.001,
         creep_limit_rad: 0.15,
         slip_output_travel_rad: 0.05, // the output's rattle alone: ±0.13 rad
-        slip_input_travel_rad: 0.045, // the kicks alone: ≤ 0.035 rad; first false alarm at 0.03
+        slip_input_travel_rad: 0.045, // the kicks alone: ≤ 0.035 rad
         slip_reversal_rad: 0.001,
         braking_grace_s: 0.4,
         braking_angle_factor: 2.0,
@@ -187,7 +186,7 @@ impl Thresholds {
         max_lost_motion_rad: 0.2, // the twin's lost motion is 0.03–0.1 rad
         current_off_max_a: 3.0,
         adc_rail_time_s: 0.01, // overrunning chatter stalls the motor at the current limit ≈ 3 ms
-        dead_current_nm: 0.5,  // healthy ≥ 1.37 N·m; a dead reading's noise ≤ 0.06 N·m
+        dead_current_nm: 0.5,  // healthy ≥ 1.42 N·m; a dead reading's noise ≈ 0.13 N·m
         dead_current_speed_rad_s: 2.0,
         health_rate_per_s: 25.0,
         impact_time_s: 0.01,

@@ -22,7 +22,6 @@ use super::convert::scale;
 use super::pack::{table1, Dir, PackSettings};
 use super::scale::Scale;
 use super::scene::Classified;
-use super::schedule::SLOW;
 use super::{mul_q16, Scene};
 use crate::fx::Q16;
 use fixed::types::U40F24;
@@ -142,21 +141,31 @@ pub(crate) fn pack(k: &PackSettings, c: &Classified, i: &PackInputs) -> PackEsti
 #[derive(Clone, Copy, Debug)]
 pub(crate) struct Energy {
     pub joules: U40F24,
+    /// The tick of the last sample.
+    at: u32,
 }
 
 impl Energy {
     pub const fn new() -> Energy {
         Energy {
             joules: U40F24::ZERO,
+            at: 0,
         }
     }
 
     /// On the slow lane's energy slot: the slip power over the ticks since the last sample.
-    pub fn update(&mut self, k: &EstimateSettings, torque: Q16, speed: Q16, slipping: bool) {
+    pub fn update(
+        &mut self,
+        k: &EstimateSettings,
+        tick: u32,
+        torque: Q16,
+        speed: Q16,
+        slipping: bool,
+    ) {
+        let ticks = tick.wrapping_sub(core::mem::replace(&mut self.at, tick)); // late ticks too
         if slipping {
             let power = mul_q16(torque, speed).saturating_abs();
-            let joules =
-                k.energy_per_tick.apply(power.to_bits()).max(0) as u64 * u64::from(SLOW.ticks);
+            let joules = k.energy_per_tick.apply(power.to_bits()).max(0) as u64 * u64::from(ticks);
             self.joules = U40F24::from_bits(self.joules.to_bits().saturating_add(joules));
         }
     }

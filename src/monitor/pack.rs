@@ -7,7 +7,7 @@
 //! | `ramp_factor` | `k = tanθ/r`: N of pressing force per N·m through the ramps | 50 /m |
 //! | `capacity_per_n` | `μ_s·c`: capacity per N of pressing force (m) | 0.0498 m |
 //! | `drive_force`, `drive_drag` | `F_s/(1 + a·k)` and `a·F` while the drive carries the load | 70 N, 1.98 N·m |
-//! | `overrun_gain`, `overrun_offset` | `y = g₁·v − g₀`, the pack torque while overrunning | 6.9, 12.7 N·m |
+//! | `overrun_gain`, `overrun_offset` | `y = g₁·v − g₀`, the pack torque while overrunning | 6.86, 11.6 N·m |
 
 use super::config::{Config, ConfigError};
 use super::convert::{finite, positive, q16, require, scale, Q16_ENVELOPE};

@@ -6,12 +6,11 @@
 //! motion (overrunning) the ramps lock the output unless the drive keeps the input shaft
 //! ahead, pushing. So with the drive on, the output turning and the pack seen holding it
 //! lately (the lock of an overrunning chatter), the drive torque averaged over a block of
-//! [`BLOCK_WINDOWS`] samples, one per 16 ticks (12.8 ms at 10 kHz), stays well above zero: at
-//! least 1.42 N·m in 6000 nominal Monte Carlo draws (seeds 2026, 7 and 11, all of them in the
-//! chatter of continuous closing, where the drive torque passes through zero for up to ≈ 10 ms
-//! of each cycle: `cargo run --release -p host-tests --example dead_current_margin -- 2000
-//! SEED`). A reading that has lost (nearly) all its gain averages what is left of it plus the
-//! magnitude of its noise (0.13 N·m at 0.1 A rms, the Monte Carlo's worst). The step check (`drive_checks.rs`) sees
+//! [`BLOCK_WINDOWS`] samples, one per 16 ticks (12.8 ms at 10 kHz), stays well above zero, even
+//! in continuous closing's chatter, where the drive torque passes through zero for up to ≈ 10 ms
+//! of each cycle (the margin: `cargo run --release -p host-tests --example dead_current_margin`,
+//! docs/decisions.md). A reading that has lost (nearly) all its gain averages what is left of it
+//! plus the magnitude of its noise. The step check (`drive.rs`) sees
 //! a gain loss of any size as a step against a steady history; in continuous closing's
 //! chatter that history never forms (the shafts do not stay synchronous for 0.1 s), and this
 //! check is what is left there — it sees only a reading that is dead or nearly so
@@ -20,12 +19,9 @@
 //! stands still, so a block is judged only if the pack held the output (stood it still, or
 //! threw it back) within the last [`HOLD_MEMORY_WINDOWS`].
 //!
-//! Runs on a tick of its own (one in 16 with the drive on, `DEAD_CURRENT_PHASE`, where no
-//! other periodic work falls), out of line: one sample of the drive torque and the output's
-//! travel since the last one per call, nothing on the other ticks (measured: on the
-//! synchronism tick the overrunning step rose from 966 to 1006 instructions on the M3, over the
-//! budget; `cargo xtask run --scene forward_load --json`). The first block after the drive
-//! starts only arms it (the drive's start is not judged).
+//! Runs on the window lane's `DeadCurrent` slot (one tick in 16 with the drive on), out of
+//! line: one sample of the drive torque and the output's travel since the last one per call.
+//! The first block after the drive starts only arms it (the drive's start is not judged).
 //!
 //! Assumptions: the drive produces torque whenever it is commanded on (a speed or position
 //! loop). A drive flagged on that commands no torque while the door coasts and rattles in its
@@ -258,7 +254,7 @@ mod tests {
     #[test]
     fn a_live_reading_or_a_still_output_is_not_dead() {
         let mut c = Check::new();
-        // Above the 0.5 N·m default: healthy chatter's lowest block mean is 1.37 N·m.
+        // Above the 0.5 N·m default: healthy chatter's lowest block mean is 1.42 N·m.
         assert_eq!(c.blocks(0.6, TURNING, true, 3), [false; 4]);
         // Output still (a stall, or the drive's start): not judged.
         assert_eq!(c.blocks(0.0, 1, true, 3), [false; 4]);

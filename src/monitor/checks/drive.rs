@@ -1,13 +1,12 @@
-//! The checks of a running drive, on one tick in four (ticks ≡ 1 mod 4; `Monitor::step`,
-//! "cost"): `brake_drag` when the pack drags beyond its allowance, and the step check that
+//! The checks of a running drive, in the slow lane's `Checks` slot (`schedule.rs`):
+//! `brake_drag` when the pack drags beyond its allowance, and the step check that
 //! raises `brake_drag` or `sensor_fault` when the drive's work jumps. A pending change of the
 //! driving reading waits while the step check counts (`counting_step`), and once it has called
 //! the current reading low no `brake_drag` is raised from that reading until the flags are
 //! reset (docs/monitor-design.md, "A change of reading waits for the step check").
 //!
 //! They live out of line (`#[inline(never)]`): the drive-off ticks — braking and holding, the
-//! monitor's worst case — then do not carry their registers (measured: +22 instructions on
-//! every tick they are not run on when inlined, `cargo xtask run --json`).
+//! monitor's worst case — then do not carry their registers (docs/decisions.md).
 //!
 //! | quantity | format | range | resolution |
 //! |---|---|---|---|

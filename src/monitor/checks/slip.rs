@@ -12,9 +12,8 @@
 //! (`thresholds.creep_limit_rad`, which must stay above the rattle) needs 50–70 ms for a slow
 //! slip. Limits and their margins: docs/monitor-design.md, "Common slip".
 //!
-//! Runs on one tick in four with the drive off (ticks ≡ 1 mod 4, which the drive checks leave
-//! free), out of line, on the counters' travel since the brake held: no work on the other
-//! ticks.
+//! Runs in the slow lane's `Checks` slot with the drive off, out of line, on the counters'
+//! travel since the brake held.
 //!
 //! | quantity | format | range | resolution |
 //! |---|---|---|---|
