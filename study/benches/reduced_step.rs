@@ -12,9 +12,7 @@ use std::time::Duration;
 
 fn one<N: Real + Widen<A>, A: Real>(c: &mut Criterion, format: &str, method: Method) {
     let p = Params::from_mechanism(&TABLE2, TABLE2.load_torque_nm, 10_000.0);
-    let Ok(mut m) = Reduced::<N, A>::new(p, method) else {
-        return;
-    };
+    let mut m = Reduced::<N, A>::new(p, method);
     m.set_drive(true, BrakingScene::REVERSE.speed_ref_rad_s);
     m.step();
     m.set_drive(false, 0.0);

@@ -42,15 +42,6 @@ use noback::mechanism::Mechanism;
 use noback::table1::{table1, Motion};
 use num::{Real, Widen};
 
-/// Binary points of the fixed-point constants (`Scale<S>`, ≥ 20 significant bits over the
-/// ranges): pack torque per newton in [2.4e-4, 0.5) m, `1/J_s` in [0.016, 32) 1/(kg·m²),
-/// steps (`dt`, `dt/2`, `dt/6`) in [9.5e-7, 2.0e-3) s (rates 1–50 kHz with ±20 % jitter).
-pub const S_CAP: u32 = 32;
-/// See [`S_CAP`].
-pub const S_INV_J: u32 = 26;
-/// See [`S_CAP`].
-pub const S_DT: u32 = 40;
-
 /// Corrector passes of the trapezoidal rule.
 pub const TRAPEZOID_ITERATIONS: u8 = 2;
 
@@ -197,29 +188,24 @@ struct Consts<N: Real, A: Real> {
     /// Pressing force while tracking (driven along the load): the pack slips at the load minus
     /// the bearing torque, `(M − M_sf)/cap_sliding`.
     tracking_force: N,
-    cap_static: N::K<S_CAP>,
-    cap_sliding: N::K<S_CAP>,
+    cap_static: N::K,
+    cap_sliding: N::K,
     bearing: N,
-    inv_j: N::K<S_INV_J>,
+    inv_j: N::K,
     backlash: A,
     band: N,
-    dt: N::K<S_DT>,
-    half_dt: N::K<S_DT>,
-    sixth_dt: N::K<S_DT>,
-    dt_a: A::K<S_DT>,
-    half_dt_a: A::K<S_DT>,
-    sixth_dt_a: A::K<S_DT>,
+    dt: N::K,
+    half_dt: N::K,
+    sixth_dt: N::K,
+    dt_a: A::K,
+    half_dt_a: A::K,
+    sixth_dt_a: A::K,
 }
 
-/// A constant that does not fit its `Scale<S>` (named by its field).
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub struct ConstantOutOfRange(pub &'static str);
-
 impl<N: Real, A: Real> Consts<N, A> {
-    fn new(p: &Params) -> Result<Self, ConstantOutOfRange> {
+    fn new(p: &Params) -> Self {
         let dt = p.dt_s;
-        let k = |name: &'static str| move |_| ConstantOutOfRange(name);
-        Ok(Consts {
+        Consts {
             load: N::from_f64(p.load_nm),
             spring: N::from_f64(p.spring_n),
             ramp_force: N::from_f64(p.load_nm * p.ramp_per_m),
@@ -228,24 +214,23 @@ impl<N: Real, A: Real> Consts<N, A> {
             } else {
                 p.spring_n + p.load_nm * p.ramp_per_m
             }),
-            cap_static: N::konst(p.cap_static_per_n_m).map_err(k("cap_static"))?,
-            cap_sliding: N::konst(p.cap_sliding_per_n_m).map_err(k("cap_sliding"))?,
+            cap_static: N::konst(p.cap_static_per_n_m),
+            cap_sliding: N::konst(p.cap_sliding_per_n_m),
             bearing: N::from_f64(p.bearing_nm),
             inv_j: N::konst(if p.inertia_kg_m2 > 0.0 {
                 1.0 / p.inertia_kg_m2
             } else {
                 0.0
-            })
-            .map_err(k("inv_j"))?,
+            }),
             backlash: A::from_f64(p.backlash_rad),
             band: N::from_f64(p.band_rad_s()),
-            dt: N::konst(dt).map_err(k("dt"))?,
-            half_dt: N::konst(dt / 2.0).map_err(k("dt"))?,
-            sixth_dt: N::konst(dt / 6.0).map_err(k("dt"))?,
-            dt_a: A::konst(dt).map_err(k("dt"))?,
-            half_dt_a: A::konst(dt / 2.0).map_err(k("dt"))?,
-            sixth_dt_a: A::konst(dt / 6.0).map_err(k("dt"))?,
-        })
+            dt: N::konst(dt),
+            half_dt: N::konst(dt / 2.0),
+            sixth_dt: N::konst(dt / 6.0),
+            dt_a: A::konst(dt),
+            half_dt_a: A::konst(dt / 2.0),
+            sixth_dt_a: A::konst(dt / 6.0),
+        }
     }
 }
 
@@ -274,11 +259,10 @@ pub struct Reduced<N: Real, A: Real = N> {
 }
 
 impl<N: Real + Widen<A>, A: Real> Reduced<N, A> {
-    /// A model at rest at angle 0, drive off, with `method`; fails when a constant does not
-    /// fit its `Scale<S>` (fixed point).
-    pub fn new(params: Params, method: Method) -> Result<Self, ConstantOutOfRange> {
-        Ok(Reduced {
-            c: Consts::new(&params)?,
+    /// A model at rest at angle 0, drive off, with `method`.
+    pub fn new(params: Params, method: Method) -> Self {
+        Reduced {
+            c: Consts::new(&params),
             params,
             method,
             state: State {
@@ -289,7 +273,7 @@ impl<N: Real + Widen<A>, A: Real> Reduced<N, A> {
             drive_on: false,
             speed_ref: N::ZERO,
             stuck: false,
-        })
+        }
     }
 
     /// The parameters.
@@ -304,14 +288,9 @@ impl<N: Real + Widen<A>, A: Real> Reduced<N, A> {
 
     /// Changes the step (configuration-time arithmetic: converts the constants again). Used for
     /// tick jitter.
-    pub fn set_dt(&mut self, dt_s: f64) -> Result<(), ConstantOutOfRange> {
-        let params = Params {
-            dt_s,
-            ..self.params
-        };
-        self.c = Consts::new(&params)?;
-        self.params = params;
-        Ok(())
+    pub fn set_dt(&mut self, dt_s: f64) {
+        self.params.dt_s = dt_s;
+        self.c = Consts::new(&self.params);
     }
 
     /// Switches the drive: on, it carries the output at `speed_ref_rad_s` (load frame) with the
@@ -369,16 +348,11 @@ impl<N: Real + Widen<A>, A: Real> Reduced<N, A> {
         // Table 1 gives the pack's resistance to the load's demand; on the output it acts
         // against it. Karnopp: inside the band the pack holds up to its static capacity.
         let (net, pack) = if w.abs() < c.band {
-            let pack = table1(Motion::Stuck, c.load, f.mulk::<S_CAP>(c.cap_static)).neg();
+            let pack = table1(Motion::Stuck, c.load, f.mulk(c.cap_static)).neg();
             (c.load.add(pack), pack)
         } else {
             let forward = w > N::ZERO;
-            let pack = table1(
-                Motion::Slipping { forward },
-                c.load,
-                f.mulk::<S_CAP>(c.cap_sliding),
-            )
-            .neg();
+            let pack = table1(Motion::Slipping { forward }, c.load, f.mulk(c.cap_sliding)).neg();
             let after_bearing = if forward {
                 c.load.sub(c.bearing)
             } else {
@@ -395,7 +369,7 @@ impl<N: Real + Widen<A>, A: Real> Reduced<N, A> {
         (
             Deriv {
                 dtheta: w,
-                domega: net.mulk::<S_INV_J>(c.inv_j),
+                domega: net.mulk(c.inv_j),
                 ddelta,
             },
             pack,
@@ -404,11 +378,11 @@ impl<N: Real + Widen<A>, A: Real> Reduced<N, A> {
 
     /// `s + h·d`, with `h` given in both formats.
     #[inline(always)]
-    fn advance(s: &State<N, A>, d: &Deriv<N>, h: N::K<S_DT>, h_a: A::K<S_DT>) -> State<N, A> {
+    fn advance(s: &State<N, A>, d: &Deriv<N>, h: N::K, h_a: A::K) -> State<N, A> {
         State {
-            theta: s.theta.add(d.dtheta.widen().mulk::<S_DT>(h_a)),
-            omega: s.omega.add(d.domega.mulk::<S_DT>(h)),
-            delta: s.delta.add(d.ddelta.widen().mulk::<S_DT>(h_a)),
+            theta: s.theta.add(d.dtheta.widen().mulk(h_a)),
+            omega: s.omega.add(d.domega.mulk(h)),
+            delta: s.delta.add(d.ddelta.widen().mulk(h_a)),
         }
     }
 
@@ -431,7 +405,7 @@ impl<N: Real + Widen<A>, A: Real> Reduced<N, A> {
             }
             Method::SemiImplicitEuler => {
                 let (d, _) = self.rhs(&s);
-                let omega = s.omega.add(d.domega.mulk::<S_DT>(c.dt));
+                let omega = s.omega.add(d.domega.mulk(c.dt));
                 let ddelta = if self.drive_on || (s.delta <= c.backlash.neg() && omega < N::ZERO) {
                     N::ZERO
                 } else {
@@ -439,9 +413,9 @@ impl<N: Real + Widen<A>, A: Real> Reduced<N, A> {
                 };
                 let dtheta = if self.drive_on { self.speed_ref } else { omega };
                 State {
-                    theta: s.theta.add(dtheta.widen().mulk::<S_DT>(c.dt_a)),
+                    theta: s.theta.add(dtheta.widen().mulk(c.dt_a)),
                     omega,
-                    delta: s.delta.add(ddelta.widen().mulk::<S_DT>(c.dt_a)),
+                    delta: s.delta.add(ddelta.widen().mulk(c.dt_a)),
                 }
             }
             Method::Rk2 => {
@@ -478,7 +452,7 @@ impl<N: Real + Widen<A>, A: Real> Reduced<N, A> {
                 next.delta = neg_b;
             }
             // Stuck when inside the band and Table 1 carries the whole load.
-            let cap = self.pressing(&next).mulk::<S_CAP>(c.cap_static);
+            let cap = self.pressing(&next).mulk(c.cap_static);
             self.stuck = next.omega.abs() < c.band && table1(Motion::Stuck, c.load, cap) == c.load;
             if self.stuck {
                 next.omega = N::ZERO;
@@ -497,7 +471,7 @@ impl<N: Real + Widen<A>, A: Real> Reduced<N, A> {
                 self.c.load.sub(self.c.bearing)
             } else if self.drive_on {
                 // Driven against the load: the pack is at spring drag, slipping.
-                self.c.spring.mulk::<S_CAP>(self.c.cap_sliding)
+                self.c.spring.mulk(self.c.cap_sliding)
             } else {
                 pack.abs()
             },
@@ -556,7 +530,7 @@ mod tests {
         rate: u32,
     ) -> (f64, bool) {
         let p = Params::from_mechanism(&TABLE2, 20.3, f64::from(rate));
-        let mut m = Reduced::<N, A>::new(p, method).unwrap();
+        let mut m = Reduced::<N, A>::new(p, method);
         m.set_drive(true, scene.speed_ref_rad_s);
         let cut = scene.release_tick(rate);
         for k in 0..rate {
@@ -587,7 +561,7 @@ mod tests {
     #[test]
     fn held_output_carries_the_load() {
         let p = Params::from_mechanism(&TABLE2, 20.3, 10_000.0);
-        let mut m = Reduced::<f64>::new(p, Method::Rk4).unwrap();
+        let mut m = Reduced::<f64>::new(p, Method::Rk4);
         for _ in 0..100 {
             m.step();
         }
