@@ -84,35 +84,59 @@ pub fn lowpass(state: Q16, input: Q16, alpha: Gain) -> Q16 {
 /// ```
 #[inline(always)]
 pub fn sat_i32(x: i64) -> i32 {
-    if x > i64::from(i32::MAX) {
-        i32::MAX
-    } else if x < i64::from(i32::MIN) {
-        i32::MIN
+    // x fits i32 iff its high word is the low word's sign extension: one 32-bit compare on a
+    // 32-bit core instead of two 64-bit ones; else MIN or MAX by the sign of x.
+    let lo = x as i32;
+    if (x >> 32) as i32 == lo >> 31 {
+        lo
     } else {
-        x as i32
+        ((x >> 63) as i32) ^ i32::MAX
     }
 }
 
-/// `a · b` in [`Q16`], **saturating** at the format's limits (a clipped torque is the safe answer).
-///
-/// ```
-/// use noback::fx::{mul_sat, Q16};
-/// assert_eq!(mul_sat(Q16::from_num(1.5), Q16::from_num(-2)), Q16::from_num(-3));
-/// assert_eq!(mul_sat(Q16::from_num(300), Q16::from_num(300)), Q16::MAX);
-/// ```
-pub fn mul_sat(a: Q16, b: Q16) -> Q16 {
-    a.saturating_mul(b)
-}
+#[cfg(test)]
+mod tests {
+    use super::sat_i32;
 
-/// Integer count times a [`Q16`] scale (e.g. ADC counts × amperes per count), **saturating**.
-///
-/// ```
-/// use noback::fx::{scale_count, Q16};
-/// assert_eq!(scale_count(-2048, Q16::from_num(0.5)), Q16::from_num(-1024));
-/// assert_eq!(scale_count(i32::MAX, Q16::from_num(2)), Q16::MAX);
-/// ```
-pub fn scale_count(count: i32, scale: Q16) -> Q16 {
-    let wide = i64::from(count) * i64::from(scale.to_bits());
-    let clamped = wide.clamp(i64::from(i32::MIN), i64::from(i32::MAX));
-    Q16::from_bits(i32::try_from(clamped).unwrap_or(i32::MAX))
+    /// The clamp `sat_i32` replaces (two 64-bit compares).
+    fn clamp_reference(x: i64) -> i32 {
+        x.clamp(i64::from(i32::MIN), i64::from(i32::MAX)) as i32
+    }
+
+    #[test]
+    fn sat_i32_is_the_clamp() {
+        for base in [
+            0,
+            i64::from(i32::MAX),
+            i64::from(i32::MIN),
+            1 << 32,
+            -(1 << 32),
+        ] {
+            for d in -3..=3 {
+                let x = base.wrapping_add(d);
+                assert_eq!(sat_i32(x), clamp_reference(x), "{x}");
+            }
+        }
+        for x in [
+            i64::MAX,
+            i64::MIN,
+            i64::MAX - 1,
+            i64::MIN + 1,
+            1 << 62,
+            -(1 << 62),
+        ] {
+            assert_eq!(sat_i32(x), clamp_reference(x), "{x}");
+        }
+        let mut s = 0x9E37_79B9_7F4A_7C15_u64;
+        for _ in 0..1_000_000 {
+            s ^= s << 13;
+            s ^= s >> 7;
+            s ^= s << 17;
+            // Full range, then every magnitude from 2^0 to 2^63.
+            let x = s as i64;
+            let y = x >> (s >> 58);
+            assert_eq!(sat_i32(x), clamp_reference(x), "{x}");
+            assert_eq!(sat_i32(y), clamp_reference(y), "{y}");
+        }
+    }
 }

@@ -9,8 +9,6 @@
 //!   capacity), written once and used by the twin in f64 and by the monitor in fixed point.
 //! - [`sensors`]: motor, reducer, ADC and encoder defaults shared by twin and monitor.
 //! - [`monitor`]: the 10 kHz reduced model, observer and failure flags.
-//! - [`reduced`]: the reduced output-shaft model, generic over number format and integrator
-//!   (the candidates of the speed-against-accuracy study, docs/speed-accuracy.md).
 //! - [`table1`]: the pack's stick/slip rule (Table 1), once for every number format.
 //! - [`fx`]: fixed-point formats and the small saturating/wrapping helpers the monitor uses.
 //! - [`vectors`]: test vectors run natively and under QEMU; the xtask compares the two digests.
@@ -29,7 +27,6 @@ pub mod exit_code;
 pub mod fx;
 pub mod mechanism;
 pub mod monitor;
-pub mod reduced;
 pub mod replay;
 pub mod sensors;
 pub mod table1;

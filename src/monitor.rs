@@ -372,7 +372,6 @@ impl State {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::fx::mul_sat;
     use crate::fx::Q16;
 
     #[test]
@@ -430,7 +429,7 @@ mod tests {
         for &a in &edges {
             for &b in &edges {
                 let (qa, qb) = (Q16::from_bits(a), Q16::from_bits(b));
-                assert_eq!(mul_q16(qa, qb), mul_sat(qa, qb), "{a} × {b}");
+                assert_eq!(mul_q16(qa, qb), qa.saturating_mul(qb), "{a} × {b}");
             }
         }
         for _ in 0..100_000 {
@@ -439,7 +438,7 @@ mod tests {
             let (c, d) = (next() >> 8, next() >> 8);
             for (a, b) in [(a, b), (c, d), (a, d)] {
                 let (qa, qb) = (Q16::from_bits(a), Q16::from_bits(b));
-                assert_eq!(mul_q16(qa, qb), mul_sat(qa, qb), "{a} × {b}");
+                assert_eq!(mul_q16(qa, qb), qa.saturating_mul(qb), "{a} × {b}");
             }
         }
     }

@@ -29,6 +29,15 @@ impl Torque for Q16 {
     }
 }
 
+/// The study crate's wide format (`noback_study`); here because of the orphan rule.
+impl Torque for fixed::types::I32F32 {
+    const ZERO: Self = Self::ZERO;
+    #[inline]
+    fn negated(self) -> Self {
+        self.saturating_neg()
+    }
+}
+
 impl Torque for f64 {
     const ZERO: f64 = 0.0;
     #[inline]

@@ -1,14 +1,17 @@
-//! Shared test vectors for the fixed-point helpers, run natively and under QEMU.
+//! Shared test vectors for the arithmetic the monitor ships, run natively and under QEMU.
 //!
 //! The vectors are generated, not stored: a fixed-seed xorshift32 stream plus the edge cases
-//! (zero, ±1 LSB, the formats' limits). [`run`] feeds every vector through every helper in
-//! [`crate::fx`], checks each result against an independent wide-integer reference, and folds
-//! the outputs into an FNV-1a digest. The host test and the target test both call it; the xtask
-//! compares the digest printed under QEMU with the one it computes natively, so "bit-identical"
-//! is checked by a third party rather than asserted by the target about itself.
+//! (zero, ±1 LSB, the formats' limits). [`run`] feeds every vector through `fx::counter_delta`,
+//! `fx::adc_centered`, `fx::lowpass`, `monitor::mul_q16`, `monitor::recip_q16` and
+//! `monitor::Scale::apply` at every binary point the monitor uses, checks each result against an
+//! independent i128 reference, and folds the outputs into an FNV-1a digest. The host test and
+//! the target test both call it; the xtask compares the digest printed under QEMU with the one
+//! it computes natively, so "bit-identical" is checked by a third party rather than asserted by
+//! the target about itself.
 
 use crate::digest::Fnv1a;
-use crate::fx::{adc_centered, counter_delta, lowpass, mul_sat, scale_count, Gain, Q16};
+use crate::fx::{adc_centered, counter_delta, lowpass, Gain, Q16};
+use crate::monitor::{mul_q16, recip_q16, Scale};
 
 /// Number of generated vectors per helper (the edge cases come on top).
 pub const GENERATED: u32 = 2000;
@@ -74,9 +77,9 @@ pub fn run() -> Report {
             break;
         };
         let third = rng.next();
-        for (got, want) in cases(a, b, third) {
+        for (got, ok) in cases(a, b, third) {
             report.cases += 1;
-            if got != want {
+            if !ok {
                 report.mismatches += 1;
             }
             fnv.push(got);
@@ -86,34 +89,86 @@ pub fn run() -> Report {
     report
 }
 
-/// The helpers' outputs for one vector, each beside its wide-integer reference.
-fn cases(a: u32, b: u32, c: u32) -> [(u32, u32); 5] {
+/// Binary points of the `Scale<S>` constants in `src/monitor` (`grep 'Scale<' src/monitor`).
+pub const SCALE_POINTS: [u32; 15] = [8, 11, 16, 20, 21, 24, 25, 26, 28, 30, 32, 33, 36, 37, 38];
+
+/// Cases per vector: three `fx` helpers, `mul_q16`, `recip_q16`, one `Scale` per binary point.
+pub const CASES_PER_VECTOR: u32 = 5 + SCALE_POINTS.len() as u32;
+
+/// The helpers' outputs for one vector, each with whether it matches its i128 reference.
+fn cases(a: u32, b: u32, c: u32) -> [(u32, bool); CASES_PER_VECTOR as usize] {
     let bits = (c % 32) as u8 + 1;
     let adc_bits = (c % 16) as u8 + 1;
-    let (qa, qb) = (Q16::from_bits(a as i32), Q16::from_bits(b as i32));
+    let (ia, ib) = (a as i32, b as i32);
+    let (qa, qb) = (Q16::from_bits(ia), Q16::from_bits(ib));
     let alpha = Gain::from_bits((c >> 16) as u16);
+    let exact = |got: i32, want: i128| (got as u32, i128::from(got) == want);
+    // A mantissa the way `Scale::from_f64` stores one: 0 or 2^20 ≤ |m| < 2^31.
+    let magnitude = (b & 0x7FFF_FFFF) | 0x0010_0000;
+    let m = if c & 1 == 0 {
+        0
+    } else if b & 0x8000_0000 != 0 {
+        -(magnitude as i32)
+    } else {
+        magnitude as i32
+    };
     [
-        (
-            counter_delta(a, b, bits) as u32,
-            ref_counter_delta(a, b, bits) as u32,
+        exact(
+            counter_delta(a, b, bits),
+            ref_counter_delta(a, b, bits).into(),
         ),
-        (
-            adc_centered(a as u16, adc_bits) as u32,
-            ref_adc_centered(a as u16, adc_bits) as u32,
+        exact(
+            adc_centered(a as u16, adc_bits),
+            ref_adc_centered(a as u16, adc_bits).into(),
         ),
-        (
-            lowpass(qa, qb, alpha).to_bits() as u32,
-            ref_lowpass(a as i32, b as i32, (c >> 16) as u16) as u32,
+        exact(
+            lowpass(qa, qb, alpha).to_bits(),
+            ref_lowpass(ia, ib, (c >> 16) as u16),
         ),
-        (
-            mul_sat(qa, qb).to_bits() as u32,
-            ref_mul_sat(a as i32, b as i32) as u32,
-        ),
-        (
-            scale_count(a as i32, qb).to_bits() as u32,
-            ref_scale(a as i32, b as i32) as u32,
-        ),
+        exact(mul_q16(qa, qb).to_bits(), ref_mul_q16(ia, ib)),
+        recip_case(ia),
+        scale_case::<8>(ia, m),
+        scale_case::<11>(ia, m),
+        scale_case::<16>(ia, m),
+        scale_case::<20>(ia, m),
+        scale_case::<21>(ia, m),
+        scale_case::<24>(ia, m),
+        scale_case::<25>(ia, m),
+        scale_case::<26>(ia, m),
+        scale_case::<28>(ia, m),
+        scale_case::<30>(ia, m),
+        scale_case::<32>(ia, m),
+        scale_case::<33>(ia, m),
+        scale_case::<36>(ia, m),
+        scale_case::<37>(ia, m),
+        scale_case::<38>(ia, m),
     ]
+}
+
+/// `Scale::<S>` with mantissa `m` (built through `from_f64`, exact for such `m`) applied to `x`,
+/// against `x·m/2^S` rounded half up and saturated.
+fn scale_case<const S: u32>(x: i32, m: i32) -> (u32, bool) {
+    let k = f64::from(m) * const { 1.0 / (1_u64 << S) as f64 };
+    let Ok(scale) = Scale::<S>::from_f64(k) else {
+        return (0, false);
+    };
+    let got = scale.apply(x);
+    let wide = (i128::from(x) * i128::from(m) + (1_i128 << (S - 1))).div_euclid(1_i128 << S);
+    let want = wide.clamp(i128::from(i32::MIN), i128::from(i32::MAX));
+    (got as u32, scale.mantissa() == m && i128::from(got) == want)
+}
+
+/// `recip_q16(x)` against `2^32/x` (1/x in Q16 bits): within 1 LSB + 2^-27 relative, i.e.
+/// `|got·x − 2^32| ≤ x + 32`; `i32::MAX` when `x ≤ 0` or the quotient does not fit.
+fn recip_case(x: i32) -> (u32, bool) {
+    let got = recip_q16(x);
+    let one = 1_i128 << 32;
+    let ok = if x <= 0 || one / i128::from(x) >= i128::from(i32::MAX) {
+        got == i32::MAX
+    } else {
+        (i128::from(got) * i128::from(x) - one).abs() <= i128::from(x) + 32
+    };
+    (got as u32, ok)
 }
 
 fn ref_counter_delta(prev: u32, now: u32, bits: u8) -> i64 {
@@ -132,21 +187,15 @@ fn ref_adc_centered(code: u16, bits: u8) -> i64 {
     i64::from(code).min(full) - (1_i64 << (bits - 1))
 }
 
-fn ref_lowpass(state: i32, input: i32, alpha: u16) -> i64 {
+fn ref_lowpass(state: i32, input: i32, alpha: u16) -> i128 {
     let num = (i128::from(input) - i128::from(state)) * i128::from(alpha);
     // floor division by 2^16
-    let step = num.div_euclid(1 << 16);
-    (i128::from(state) + step) as i64
+    i128::from(state) + num.div_euclid(1 << 16)
 }
 
-fn ref_mul_sat(a: i32, b: i32) -> i64 {
+fn ref_mul_q16(a: i32, b: i32) -> i128 {
     let p = (i128::from(a) * i128::from(b)).div_euclid(1 << 16);
-    p.clamp(i128::from(i32::MIN), i128::from(i32::MAX)) as i64
-}
-
-fn ref_scale(count: i32, scale: i32) -> i64 {
-    let p = i128::from(count) * i128::from(scale);
-    p.clamp(i128::from(i32::MIN), i128::from(i32::MAX)) as i64
+    p.clamp(i128::from(i32::MIN), i128::from(i32::MAX))
 }
 
 #[cfg(test)]
@@ -157,6 +206,6 @@ mod tests {
     fn every_vector_matches_its_reference() {
         let report = run();
         assert_eq!(report.mismatches, 0, "{report:?}");
-        assert_eq!(report.cases, 5 * (100 + GENERATED));
+        assert_eq!(report.cases, CASES_PER_VECTOR * (100 + GENERATED));
     }
 }

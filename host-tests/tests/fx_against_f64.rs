@@ -1,19 +1,21 @@
-//! Property tests: each fixed-point helper in `noback::fx` against its f64 reference.
+//! Property tests: each fixed-point helper the monitor ships (`noback::fx`, `mul_q16`,
+//! `Scale::apply`) against its f64 reference.
 //!
 //! The bound in each test is the format's resolution (one LSB, 2⁻¹⁶), since the helpers
 //! truncate toward −∞; anything larger is a bug, not rounding.
 
-use noback::fx::{adc_centered, counter_delta, lowpass, mul_sat, scale_count, Gain, Q16};
+use noback::fx::{adc_centered, counter_delta, lowpass, Gain, Q16};
+use noback::monitor::{mul_q16, Scale};
 use proptest::prelude::*;
 
 const LSB: f64 = 1.0 / 65_536.0;
 
 proptest! {
     #[test]
-    fn mul_sat_is_within_one_lsb_or_saturated(a in any::<i32>(), b in any::<i32>()) {
+    fn mul_q16_is_within_one_lsb_or_saturated(a in any::<i32>(), b in any::<i32>()) {
         let (qa, qb) = (Q16::from_bits(a), Q16::from_bits(b));
         let exact = qa.to_num::<f64>() * qb.to_num::<f64>();
-        let got = mul_sat(qa, qb).to_num::<f64>();
+        let got = mul_q16(qa, qb).to_num::<f64>();
         let clamped = exact.clamp(Q16::MIN.to_num::<f64>(), Q16::MAX.to_num::<f64>());
         prop_assert!((got - clamped).abs() <= LSB, "{} * {} = {} want {}", qa, qb, got, clamped);
     }
@@ -42,11 +44,13 @@ proptest! {
     }
 
     #[test]
-    fn scale_count_matches_f64(count in -1_000_000_i32..1_000_000, scale in -100.0_f64..100.0) {
-        let q = Q16::from_num(scale);
-        let exact = f64::from(count) * q.to_num::<f64>();
-        let clamped = exact.clamp(Q16::MIN.to_num::<f64>(), Q16::MAX.to_num::<f64>());
-        prop_assert!((scale_count(count, q).to_num::<f64>() - clamped).abs() <= LSB);
+    fn scale_apply_is_within_half_an_lsb_or_saturated(x in -(1_i32 << 22)..(1 << 22), k in -3e4_f64..3e4) {
+        // Rounded to nearest: within ½ LSB of x·k for the stored k (|x·mantissa| < 2^53, so
+        // the f64 product is exact).
+        let Ok(scale) = Scale::<16>::from_f64(k) else { return Ok(()) };
+        let exact = f64::from(x) * scale.to_f64();
+        let clamped = exact.clamp(f64::from(i32::MIN), f64::from(i32::MAX));
+        prop_assert!((f64::from(scale.apply(x)) - clamped).abs() <= 0.5);
     }
 }
 

@@ -1,13 +1,13 @@
 //! `cargo xtask bench [--quick] [--json]` — speed against accuracy (issue 6).
 //!
 //! 1. The twin's `paper` reading at its tightest tolerance is the reference of the reduced model
-//!    (`noback::reduced`): the reduced model is that reading's quasi-static physics at a fixed
-//!    step, so this isolates the error of format, integrator and rate.
+//!    (`noback_study::reduced`): the reduced model is that reading's quasi-static physics at a
+//!    fixed step, so this isolates the error of format, integrator and rate.
 //! 2. Every format × integrator × rate of the reduced model on `reverse_load` and
 //!    `forward_load`: output-angle and speed RMS, pressing-force RMS (% of the loaded force),
 //!    braking-torque RMS, lock-time error; host ns per step (criterion,
-//!    `host-tests/benches/reduced_step.rs`); Cortex-M3 instructions per step under QEMU
-//!    (`noback-bench`, `-icount shift=10`), and per simulated second.
+//!    `study/benches/reduced_step.rs`); Cortex-M3 instructions per step under QEMU
+//!    (`noback-study`'s `noback-bench`, `-icount shift=10`), and per simulated second.
 //! 3. The twin itself at several tolerances, both readings, against its tightest run.
 //! 4. The full physical model (`TwinModel::rhs`) with explicit Euler and RK4 at fixed steps from
 //!    0.5 µs up past their stability limit, varying contact stiffness, the connecting-shaft
@@ -26,8 +26,8 @@ use crate::shell::{self, cargo, workspace_root};
 use explicit::{Explicit, Verdict};
 use fixed::types::{I16F16, I32F32};
 use noback::mechanism::TABLE2;
-use noback::reduced::num::{Real, Widen};
-use noback::reduced::{BrakingScene, Method, Params, Reduced};
+use noback_study::reduced::num::{Real, Widen};
+use noback_study::reduced::{BrakingScene, Method, Params, Reduced};
 use noback_twin::model::physical::Physical;
 use noback_twin::model::Sample;
 use noback_twin::reading::Reading;
@@ -178,13 +178,13 @@ fn run_reduced_by_name(
     }
 }
 
-/// Runs the criterion benchmark `host-tests/benches/reduced_step.rs` (host nanoseconds per
+/// Runs the criterion benchmark `study/benches/reduced_step.rs` (host nanoseconds per
 /// step of every format × integrator).
 fn run_criterion() -> Result<(), String> {
     shell::run(cargo().args([
         "bench",
         "-p",
-        "host-tests",
+        "noback-study",
         "--bench",
         "reduced_step",
         "--",
@@ -307,7 +307,7 @@ impl Variant {
 /// Instructions per step (mean, max) of every format × integrator on `core`, from
 /// `noback-bench` under QEMU.
 fn core_costs(core: Core, echo: bool) -> Result<Vec<(String, String, f64, f64)>, String> {
-    let elf = crate::run::build_bin("noback-bench", core, None, &[])?;
+    let elf = crate::run::build_package_bin("noback-study", "noback-bench", core, None, &[])?;
     let shift = crate::run::BENCH_SHIFT;
     let out = qemu::boot(&Boot {
         elf: &elf,
@@ -741,7 +741,7 @@ pub fn main(args: &[String]) -> Result<i32, String> {
         });
     }
     // The reduced model.
-    eprintln!("bench: host ns per step (criterion, host-tests/benches/reduced_step.rs)");
+    eprintln!("bench: host ns per step (criterion, study/benches/reduced_step.rs)");
     run_criterion()?;
     let total = FORMATS.len() * Method::ALL.len();
     let mut done = 0;

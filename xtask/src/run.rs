@@ -347,10 +347,21 @@ pub fn build_bin(
     target_dir: Option<&std::path::Path>,
     envs: &[(&str, &std::ffi::OsStr)],
 ) -> Result<String, String> {
+    build_package_bin("noback", bin, core, target_dir, envs)
+}
+
+/// [`build_bin`] for a binary of another workspace package (the study crate's bench image).
+pub fn build_package_bin(
+    package: &str,
+    bin: &str,
+    core: Core,
+    target_dir: Option<&std::path::Path>,
+    envs: &[(&str, &std::ffi::OsStr)],
+) -> Result<String, String> {
     let dir = target_dir.map_or_else(|| workspace_root().join("target"), std::path::PathBuf::from);
     shell::run(
         cargo()
-            .args(["build", "--release", "-p", "noback", "--bin", bin])
+            .args(["build", "--release", "-p", package, "--bin", bin])
             .args(["--target", core.triple(), "--target-dir"])
             .arg(&dir)
             .envs(envs.iter().copied()),

@@ -8,8 +8,8 @@
 
 use fixed::types::{I16F16, I32F32};
 use noback::mechanism::TABLE2;
-use noback::reduced::num::{Real, Widen, WrapQ16};
-use noback::reduced::{Method, Params, Reduced};
+use noback_study::reduced::num::{Real, Widen, WrapQ16};
+use noback_study::reduced::{Method, Params, Reduced};
 
 fn creep<N: Real + Widen<A>, A: Real>() -> f64 {
     let p = Params::from_mechanism(&TABLE2, 20.3, 10_000.0);

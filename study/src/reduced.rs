@@ -8,9 +8,10 @@
 //! quasi-static, as in the twin's `paper` reading: the pressing force is the spring preload, plus
 //! the ramp force `M·tanθ/r` while the load-holding ramp face is engaged (`δ ≥ 0`, with `δ` the
 //! output's angle relative to the input side); the pack capacity is
-//! `T_all = μ·(2N_f − 1)·r_f·F` (Table 1) with μ_s stuck and `mu_sliding` slipping (μ_s too in
-//! the paper reading). Stick/slip is a Karnopp band: inside `|ω| < band` the pack holds up to
-//! `T_all` (`T = clamp(M, ±T_all)`), outside it slips (`T = T_all·sgn ω`); after each step an
+//! `T_all = μ·(2N_f − 1)·r_f·F` with μ_s stuck and `mu_sliding` slipping (μ_s too in the paper
+//! reading). Stick/slip is Table 1 (`noback::table1`, the monitor's rule) with a Karnopp band:
+//! inside `|ω| < band` the pack holds up to `T_all` (`T = clamp(M, ±T_all)`), outside it slips
+//! (`T = T_all·sgn ω`); after each step an
 //! output inside the band that the pack can hold is set to rest (`ω = 0`). The band is one
 //! step's largest speed change, so a zero crossing always lands in it.
 //!
@@ -37,7 +38,8 @@
 
 pub mod num;
 
-use crate::mechanism::Mechanism;
+use noback::mechanism::Mechanism;
+use noback::table1::{table1, Motion};
 use num::{Real, Widen};
 
 /// Corrector passes of the trapezoidal rule.
@@ -128,7 +130,7 @@ impl Params {
             cap_sliding_per_n_m: m.pack_torque_per_newton_m(m.mu_static),
             bearing_nm: m.mu_dynamic
                 * m.output_shaft_mass_kg
-                * crate::mechanism::GRAVITY_M_S2
+                * noback::mechanism::GRAVITY_M_S2
                 * m.output_friction_radius_m,
             backlash_rad: 2.0 * m.socket_clearance_m / (m.socket_radius_m * cos),
             dt_s: if rate_hz > 0.0 { 1.0 / rate_hz } else { 1e-4 },
@@ -343,19 +345,20 @@ impl<N: Real + Widen<A>, A: Real> Reduced<N, A> {
         let f = self.pressing(s);
         let w = s.omega;
         let c = &self.c;
+        // Table 1 gives the pack's resistance to the load's demand; on the output it acts
+        // against it. Karnopp: inside the band the pack holds up to its static capacity.
         let (net, pack) = if w.abs() < c.band {
-            // Karnopp: the pack holds up to its static capacity.
-            let cap = f.mulk(c.cap_static);
-            let pack = c.load.clamp_sym(cap).neg();
+            let pack = table1(Motion::Stuck, c.load, f.mulk(c.cap_static)).neg();
             (c.load.add(pack), pack)
         } else {
-            let cap = f.mulk(c.cap_sliding);
-            if w > N::ZERO {
-                let pack = cap.neg();
-                (c.load.sub(c.bearing).add(pack), pack)
+            let forward = w > N::ZERO;
+            let pack = table1(Motion::Slipping { forward }, c.load, f.mulk(c.cap_sliding)).neg();
+            let after_bearing = if forward {
+                c.load.sub(c.bearing)
             } else {
-                (c.load.add(c.bearing).add(cap), cap)
-            }
+                c.load.add(c.bearing)
+            };
+            (after_bearing.add(pack), pack)
         };
         // The far face is a stop: δ stays at −b while the output runs against the load.
         let ddelta = if s.delta <= c.backlash.neg() && w < N::ZERO {
@@ -448,8 +451,9 @@ impl<N: Real + Widen<A>, A: Real> Reduced<N, A> {
             if next.delta < neg_b {
                 next.delta = neg_b;
             }
+            // Stuck when inside the band and Table 1 carries the whole load.
             let cap = self.pressing(&next).mulk(c.cap_static);
-            self.stuck = next.omega.abs() < c.band && c.load <= cap;
+            self.stuck = next.omega.abs() < c.band && table1(Motion::Stuck, c.load, cap) == c.load;
             if self.stuck {
                 next.omega = N::ZERO;
             }
@@ -517,8 +521,8 @@ impl BrakingScene {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::mechanism::TABLE2;
     use fixed::types::{I16F16, I32F32};
+    use noback::mechanism::TABLE2;
 
     fn braking<N: Real + Widen<A>, A: Real>(
         method: Method,

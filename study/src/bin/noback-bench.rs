@@ -1,5 +1,5 @@
 //! Cost bench of the reduced-model variants (issue 6): every number format × integrator of
-//! `noback::reduced` steps the paper's reverse-load braking at 10 kHz from the drive cut until
+//! `noback_study::reduced` steps the paper's reverse-load braking at 10 kHz from the drive cut until
 //! the pack has held for a while, each step measured alone with SysTick (`Meter`), for
 //! deterministic instruction counts under QEMU `-icount` (`cargo xtask bench` boots it on the
 //! Cortex-M3 and converts ticks to instructions as `cargo xtask run` does).
@@ -14,8 +14,8 @@ mod target {
     use fixed::types::{I16F16, I32F32};
     use noback::mechanism::TABLE2;
     use noback::platform::{self, meter::Meter};
-    use noback::reduced::num::{Real, Widen};
-    use noback::reduced::{BrakingScene, Method, Params, Reduced};
+    use noback_study::reduced::num::{Real, Widen};
+    use noback_study::reduced::{BrakingScene, Method, Params, Reduced};
 
     /// Step rate of the measured runs.
     const RATE_HZ: u32 = 10_000;

@@ -6,8 +6,8 @@
 
 use fixed::types::{I16F16, I32F32};
 use noback::mechanism::{Mechanism, TABLE2};
-use noback::reduced::num::{Real, Widen};
-use noback::reduced::{BrakingScene, Method, Params, Reduced};
+use noback_study::reduced::num::{Real, Widen};
+use noback_study::reduced::{BrakingScene, Method, Params, Reduced};
 
 /// Runs 1 s of a braking scene; `jitter` scales each step by `1 ± 0.2`. Returns the final
 /// angle, whether the pack holds, the braking torque and the largest pressing force seen.

@@ -12,23 +12,24 @@
 //! answer, a wrapped one changes sign (`tests/bench_fixed_point.rs` shows the difference at
 //! extreme loads). `I16F16` multiplies by constants through [`KQ16`], a 32-bit mantissa with
 //! its own binary point, because a step `dt = 1e-4 s` is only 6.5 ulps of `I16F16` (7 %
-//! error): constants must not be stored in the state's format.
+//! error): constants must not be stored in the state's format. The monitor's `Scale<S>` would
+//! do (one `S` per role) but halves the measured I16F16 step cost, so the study keeps the
+//! figures it published (docs/decisions.md, issue 15).
 //!
 //! Conversions from `f64` ([`Real::from_f64`], [`Real::konst`]) are for configuration time;
 //! the step itself uses only [`Real::add`], [`Real::sub`], [`Real::mulk`], comparisons and
 //! [`Widen::widen`].
 
-use crate::fx::sat_i32 as sat32;
 use fixed::types::{I16F16, I32F32};
+use noback::fx::sat_i32 as sat32;
+use noback::table1::Torque;
 
-/// A number format of the reduced model.
-pub trait Real: Copy + PartialOrd + core::fmt::Debug {
+/// A number format of the reduced model (a [`Torque`] so that Table 1 applies to it).
+pub trait Real: Torque + core::fmt::Debug {
     /// The format of multiplicative constants (`dt`, `1/J`, capacities per newton).
     type K: Copy + core::fmt::Debug;
     /// Short name used in tables (`f64`, `f32`, `I16F16`, `I32F32`, `wrapI16F16`).
     const NAME: &'static str;
-    /// Zero.
-    const ZERO: Self;
     /// Converts (saturating for fixed point; NaN becomes 0).
     fn from_f64(x: f64) -> Self;
     /// The value as `f64` (for reports; exact for every format here).
@@ -49,17 +50,6 @@ pub trait Real: Copy + PartialOrd + core::fmt::Debug {
     fn abs(self) -> Self {
         if self < Self::ZERO {
             self.neg()
-        } else {
-            self
-        }
-    }
-    /// `self` clamped to `[−lim, lim]` (`lim ≥ 0`).
-    fn clamp_sym(self, lim: Self) -> Self {
-        let lo = lim.neg();
-        if self > lim {
-            lim
-        } else if self < lo {
-            lo
         } else {
             self
         }
@@ -89,7 +79,6 @@ impl Widen<I32F32> for I16F16 {
 impl Real for f64 {
     type K = f64;
     const NAME: &'static str = "f64";
-    const ZERO: Self = 0.0;
     fn from_f64(x: f64) -> Self {
         x
     }
@@ -123,7 +112,6 @@ impl Real for f64 {
 impl Real for f32 {
     type K = f32;
     const NAME: &'static str = "f32";
-    const ZERO: Self = 0.0;
     fn from_f64(x: f64) -> Self {
         x as f32
     }
@@ -210,7 +198,6 @@ impl KQ16 {
 impl Real for I16F16 {
     type K = KQ16;
     const NAME: &'static str = "I16F16";
-    const ZERO: Self = I16F16::ZERO;
     fn from_f64(x: f64) -> Self {
         I16F16::saturating_from_num(if x.is_nan() { 0.0 } else { x })
     }
@@ -244,7 +231,6 @@ impl Real for I16F16 {
 impl Real for I32F32 {
     type K = I32F32;
     const NAME: &'static str = "I32F32";
-    const ZERO: Self = I32F32::ZERO;
     fn from_f64(x: f64) -> Self {
         I32F32::saturating_from_num(if x.is_nan() { 0.0 } else { x })
     }
@@ -280,10 +266,16 @@ impl Real for I32F32 {
 #[derive(Clone, Copy, Debug, PartialEq, PartialOrd)]
 pub struct WrapQ16(pub I16F16);
 
+impl Torque for WrapQ16 {
+    const ZERO: Self = WrapQ16(I16F16::ZERO);
+    fn negated(self) -> Self {
+        WrapQ16(self.0.wrapping_neg())
+    }
+}
+
 impl Real for WrapQ16 {
     type K = KQ16;
     const NAME: &'static str = "wrapI16F16";
-    const ZERO: Self = WrapQ16(I16F16::ZERO);
     fn from_f64(x: f64) -> Self {
         WrapQ16(I16F16::wrapping_from_num(if x.is_nan() { 0.0 } else { x }))
     }

@@ -5,8 +5,8 @@
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion};
 use fixed::types::{I16F16, I32F32};
 use noback::mechanism::TABLE2;
-use noback::reduced::num::{Real, Widen};
-use noback::reduced::{BrakingScene, Method, Params, Reduced};
+use noback_study::reduced::num::{Real, Widen};
+use noback_study::reduced::{BrakingScene, Method, Params, Reduced};
 use std::hint::black_box;
 use std::time::Duration;
 
