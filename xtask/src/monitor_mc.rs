@@ -300,6 +300,23 @@ fn finish(
     Ok(())
 }
 
+/// The report (JSON text) of the shipped monitor's unsharded campaign, as `--json` prints it.
+pub fn unsharded_report(seed: u64, runs: u64, fault_runs: u64) -> Result<String, String> {
+    let setup = Setup::default();
+    let part = run_part(
+        &setup,
+        campaign_of(&setup, seed, runs, fault_runs),
+        0,
+        1,
+        threads(None),
+    );
+    let part: Part =
+        serde_json::from_str(&serde_json::to_string(&part).map_err(|e| e.to_string())?)
+            .map_err(|e| e.to_string())?;
+    let (c, outcomes) = part::merge(&[("the campaign".into(), part)], false)?;
+    Ok(report_of(&c, &outcomes, setup)?.0.to_string())
+}
+
 /// The report (JSON) and `docs/monitor.md` of a campaign's outcomes.
 pub fn report_of(
     campaign: &Campaign,
