@@ -63,7 +63,7 @@ pub const COMMANDS: &[(&str, &str)] = &[
     ),
     (
         "monitor-mc",
-        "[--runs N] [--fault-runs K] [--seed S] [--json] [--no-doc] [--power-on-settle S] [--pre-roll S]: detection by Monte Carlo; writes docs/monitor.md",
+        "[--runs N] [--fault-runs K] [--seed S] [--json] [--no-doc] [--shard K/N --out FILE] | merge PART… | throughput: detection by Monte Carlo with 95 % intervals; writes docs/monitor.md (--help for all)",
     ),
     (
         "fuzz",

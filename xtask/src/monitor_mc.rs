@@ -10,7 +10,7 @@ mod throughput;
 
 use crate::shell::workspace_root;
 use clap::{Args, Parser, Subcommand};
-use host_tests::mc::{draw, run_all, Campaign as Setup, FAULT_KINDS, PLANT_FAMILY};
+use host_tests::mc::{draw, draw_legacy, run_all, Campaign as Setup, FAULT_KINDS, PLANT_FAMILY};
 use part::{Campaign, Part};
 use std::io::Write as _;
 use std::path::{Path, PathBuf};
@@ -71,6 +71,10 @@ struct RunArgs {
     /// Write the runs' part file here (a shard's, or the whole campaign's).
     #[arg(long, value_name = "FILE")]
     out: Option<PathBuf>,
+    /// Draw as the campaigns before sharding did (`host_tests::mc::draw_legacy`), to compare
+    /// figures across the change of random stream; the page is not written.
+    #[arg(long)]
+    legacy_draws: bool,
     /// Worker threads (default: the machine's cores).
     #[arg(long, value_parser = clap::value_parser!(u64).range(1..=1024))]
     threads: Option<u64>,
@@ -163,11 +167,19 @@ fn threads(given: Option<u64>) -> usize {
     )
 }
 
+/// The plant family of [`RunArgs::legacy_draws`]: the default family, drawn by the old stream.
+const LEGACY_FAMILY: &str = "physical-default, pre-sharding stream";
+
 /// Runs shard `k` of `n` of a campaign and returns its part.
 pub fn run_part(setup: &Setup, campaign: Campaign, k: u64, n: u64, threads: usize) -> Part {
     let nominal = part::slice(campaign.runs, k, n);
     let faults = part::slice(campaign.fault_runs, k, n);
     let seed = campaign.seed;
+    let draw = if campaign.plant_family == LEGACY_FAMILY {
+        draw_legacy
+    } else {
+        draw
+    };
     let mut draws: Vec<_> = nominal.clone().map(|i| draw(seed, i, None)).collect();
     for kind in FAULT_KINDS {
         draws.extend(faults.clone().map(|i| draw(seed, i, Some(kind))));
@@ -216,7 +228,10 @@ fn run_main(a: &RunArgs) -> Result<(), Fail> {
     }
     noback::monitor::Monitor::new(setup.config)
         .map_err(|e| Fail::Input(format!("monitor configuration: {e:?}")))?;
-    let campaign = campaign_of(&setup, a.seed, a.runs, a.fault_runs);
+    let mut campaign = campaign_of(&setup, a.seed, a.runs, a.fault_runs);
+    if a.legacy_draws {
+        campaign.plant_family = LEGACY_FAMILY.into();
+    }
     let (k, n) = a.shard.unwrap_or((0, 1));
     let part = run_part(&setup, campaign, k, n, threads(a.threads));
     let text = serde_json::to_string(&part).map_err(|e| e.to_string())?;
@@ -229,7 +244,8 @@ fn run_main(a: &RunArgs) -> Result<(), Fail> {
     }
     // The page describes the shipped monitor: an ablation does not overwrite it.
     let shipped = Setup::default();
-    let ablation = setup.config != shipped.config || setup.pre_roll_s != shipped.pre_roll_s;
+    let ablation =
+        setup.config != shipped.config || setup.pre_roll_s != shipped.pre_roll_s || a.legacy_draws;
     // Through the part's text, as a merge reads it: the same bytes whichever way.
     let part = serde_json::from_str(&text).map_err(|e| e.to_string())?;
     let parts = [("the campaign".into(), part)];
@@ -260,7 +276,11 @@ fn merge_main(m: &MergeArgs) -> Result<(), Fail> {
             )));
         }
     }
-    let ablation = setup.config != shipped.config || setup.pre_roll_s != shipped.pre_roll_s;
+    let legacy = parts
+        .first()
+        .is_some_and(|(_, p)| p.campaign.plant_family == LEGACY_FAMILY);
+    let ablation =
+        setup.config != shipped.config || setup.pre_roll_s != shipped.pre_roll_s || legacy;
     finish(
         &parts,
         m.prefix,

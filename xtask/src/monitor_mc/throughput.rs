@@ -27,11 +27,28 @@ fn first_line_with(path: &str, key: &str) -> String {
         .unwrap_or_else(|| "unknown".into())
 }
 
-/// Runs per second of `draws` on `threads` workers.
-fn rate(draws: &[host_tests::mc::Draw], threads: usize) -> f64 {
-    let started = Instant::now();
+/// CPU seconds this process has used, all threads (`/proc/self/stat` utime + stime, at the
+/// kernel's USER_HZ of 100).
+fn cpu_s() -> f64 {
+    let stat = std::fs::read_to_string("/proc/self/stat").unwrap_or_default();
+    // Fields after the command's closing parenthesis; utime and stime are the 12th and 13th.
+    let rest = stat.rsplit_once(')').map_or("", |(_, r)| r);
+    let f: Vec<f64> = rest
+        .split_whitespace()
+        .filter_map(|x| x.parse().ok())
+        .collect();
+    (f.get(11).copied().unwrap_or(0.0) + f.get(12).copied().unwrap_or(0.0)) / 100.0
+}
+
+/// Runs per wall-clock second and per CPU second of `draws` on `threads` workers.
+fn rate(draws: &[host_tests::mc::Draw], threads: usize) -> (f64, f64) {
+    let (wall, cpu) = (Instant::now(), cpu_s());
     let _ = run_all(draws, &Campaign::default(), threads, &|_, _| {});
-    draws.len() as f64 / started.elapsed().as_secs_f64()
+    let n = draws.len() as f64;
+    (
+        n / wall.elapsed().as_secs_f64(),
+        n / (cpu_s() - cpu).max(0.01),
+    )
 }
 
 /// Entry.
@@ -50,27 +67,28 @@ pub fn main(a: &ThroughputArgs) -> Result<(), String> {
         nominal.len(),
         faults.len()
     );
-    let one = rate(&nominal, 1);
-    let one_fault = rate(&faults, 1);
-    let all = rate(&nominal, cores);
+    let (one, one_cpu) = rate(&nominal, 1);
+    let (fault, fault_cpu) = rate(&faults, 1);
+    let (all, _) = rate(&nominal, cores);
     let mut s = String::new();
     let _ = writeln!(
         s,
         "# Monte Carlo throughput (benchmark: machine-dependent)\n\n\
          Written by `cargo xtask monitor-mc throughput --runs {}`; timings differ from run to run \
          and machine to machine, unlike `monitor.md`. Machine: {cpu}, {cores} cores as the OS \
-         reports them, load average {load} when it started (the machine was shared).\n\n\
-         | what | runs/s |\n|---|---|\n\
-         | nominal runs, 1 thread (per core) | {one:.1} |\n\
-         | fault runs, 1 thread (per core) | {one_fault:.1} |\n\
-         | nominal runs, {cores} threads | {all:.1} |\n\n\
-         A 10⁶-run nominal campaign at {one:.1} runs/s per core, shards spread evenly (one per \
-         core, `slurm/`), merge not counted (seconds):\n\n\
+         reports them, load average {load} when it started (shared: wall-clock rates fall with \
+         the load, rates per CPU second much less).\n\n\
+         | what | runs per wall-clock second | runs per CPU second |\n|---|---|---|\n\
+         | nominal runs, 1 thread | {one:.1} | {one_cpu:.1} |\n\
+         | fault runs, 1 thread | {fault:.1} | {fault_cpu:.1} |\n\
+         | nominal runs, {cores} threads | {all:.1} | |\n\n\
+         A 10⁶-run nominal campaign at {one_cpu:.1} runs per CPU second per core (an unloaded \
+         core), one shard per core (`slurm/submit.sh`), merge not counted:\n\n\
          | nodes | cores each | wall time |\n|---|---|---|",
         a.runs
     );
-    for (nodes, per) in [(1, cores), (10, 32), (50, 32), (100, 64)] {
-        let hours = 1e6 / (one * (nodes * per) as f64) / 3600.0;
+    for (nodes, per) in [(1, cores), (1, 32), (10, 32), (100, 32)] {
+        let hours = 1e6 / (one_cpu * (nodes * per) as f64) / 3600.0;
         let _ = writeln!(s, "| {nodes} | {per} | {hours:.2} h |");
     }
     let path = workspace_root().join("docs/results/mc-throughput.md");
