@@ -12,15 +12,17 @@ use std::fmt::Write as _;
 /// The committed record of the certification-scale nominal campaign (a merged report).
 pub const CAMPAIGN_RECORD: &str = "docs/results/mc-nominal-campaign.json";
 
-/// How many shards the campaign of [`CAMPAIGN_RECORD`] was cut into.
-pub const CAMPAIGN_SHARDS: u64 = 20;
+/// The campaign of [`CAMPAIGN_RECORD`] as planned: nominal runs, shards, seed.
+pub const CAMPAIGN_PLAN: (u64, u64, u64) = (100_000, 20, 101);
 
-/// The command that made [`CAMPAIGN_RECORD`], with its size and seed filled in: the shards two
-/// at a time (one per core), then the merge.
-pub fn campaign_command(runs: &Value, seed: &Value) -> String {
+/// The commands that made [`CAMPAIGN_RECORD`]: the planned shards two at a time (one per core),
+/// then the merge (`--prefix` when only the first shards were run).
+pub fn campaign_command(prefix: bool) -> String {
+    let (runs, shards, seed) = CAMPAIGN_PLAN;
     format!(
-        "seq 0 {} | xargs -P 2 -I K nice -n 5 cargo xtask monitor-mc --runs {runs} --fault-runs 0 --seed {seed} --threads 1 --shard K/{CAMPAIGN_SHARDS} --out part-K.json && cargo xtask monitor-mc merge part-*.json --no-doc --out {CAMPAIGN_RECORD}",
-        CAMPAIGN_SHARDS - 1
+        "seq 0 {} | xargs -P 2 -I K nice -n 5 cargo xtask monitor-mc --runs {runs} --fault-runs 0 --seed {seed} --threads 1 --shard K/{shards} --out part-K.json\ncargo xtask monitor-mc merge part-*.json{} --no-doc --out {CAMPAIGN_RECORD}",
+        shards - 1,
+        if prefix { " --prefix" } else { "" }
     )
 }
 
@@ -39,7 +41,11 @@ fn fmt_opt(v: &Value, scale: f64, digits: usize) -> String {
 }
 
 fn sci(v: &Value) -> String {
-    v.as_f64().map_or("—".into(), |x| format!("{x:.2e}"))
+    match v.as_f64() {
+        None => "—".into(),
+        Some(0.0) => "0".into(),
+        Some(x) => format!("{x:.2e}"),
+    }
 }
 
 /// The false-alarm sentence: count, rate, interval, upper bound per run and per flight hour.
@@ -54,8 +60,8 @@ pub fn false_alarm_line(r: &Value) -> String {
         sci(&fa["ci95"][1]),
         sci(&fa["ci95"][1]),
         sci(&r["false_alarm_per_flight_hour_upper95"]),
-        r["door_cycles_per_flight_hour"],
-        r["runs_per_door_cycle"],
+        r["door_cycles_per_flight_hour"].as_f64().unwrap_or(0.0),
+        r["runs_per_door_cycle"].as_f64().unwrap_or(0.0),
     )
 }
 
@@ -187,18 +193,37 @@ fn campaign_sizes(r: &Value) -> String {
 }
 
 /// The certification-scale campaign's paragraph, from its committed record.
-fn campaign_section(record: Option<&Value>) -> String {
+fn campaign_section(record: Option<&Value>, current: &Value) -> String {
     let Some(c) = record else {
         return format!("No record in `{CAMPAIGN_RECORD}` yet.\n");
     };
+    let (planned, shards, _) = CAMPAIGN_PLAN;
+    let runs = c["runs"].as_u64().unwrap_or(0);
+    let done = if runs < planned {
+        format!(
+            "the first {} of its {shards} shards finished in the time the session had, merged with \
+             `--prefix` into the campaign of their {runs} runs (the same report as \
+             `cargo xtask monitor-mc --runs {runs} --fault-runs 0 --seed {}`: a run's draws do not \
+             depend on the campaign's size)",
+            runs * shards / planned,
+            c["seed"],
+        )
+    } else {
+        format!("all {shards} shards run and merged")
+    };
+    let stale = if c["config_digest"] == current["config_digest"] {
+        ""
+    } else {
+        " (not this page's monitor configuration: the bound is for the configuration recorded)"
+    };
     format!(
-        "Seed {} (an evaluation seed: no threshold was tuned on it), plant family `{}`, monitor configuration digest {}, {} nominal runs, sharded {} ways on this machine and merged:\n\n```sh\n{}\n```\n\n{}\n",
+        "Seed {} (an evaluation seed: no threshold was tuned on it), plant family `{}`, monitor \
+         configuration digest {}{stale}. Planned: {planned} nominal runs in {shards} shards on this \
+         machine; {done}:\n\n```sh\n{}\n```\n\n{}\n",
         c["seed"],
         c["plant_family"].as_str().unwrap_or(""),
         c["config_digest"].as_str().unwrap_or(""),
-        c["runs"],
-        CAMPAIGN_SHARDS,
-        campaign_command(&c["runs"], &c["seed"]),
+        campaign_command(runs < planned),
         false_alarm_line(c),
     )
 }
@@ -278,13 +303,13 @@ pub fn doc(r: &Value, record: Option<&Value>) -> String {
         slip = FAILED_HOLD_SLIP_S * 1e3,
         window = DETECTION_WINDOW_S * 1e3,
         target = DETECTION_TARGET * 100.0,
-        cycles = r["door_cycles_per_flight_hour"],
-        per_cycle = r["runs_per_door_cycle"],
+        cycles = r["door_cycles_per_flight_hour"].as_f64().unwrap_or(0.0),
+        per_cycle = r["runs_per_door_cycle"].as_f64().unwrap_or(0.0),
         armed = checks_armed_s(&Config::default()) * 1e3,
         compare = COMPARE_WINDOW_S * 1e3,
         table = table(r),
         met = if r["targets_met"] == true { "yes" } else { "no" },
-        campaign = campaign_section(record),
+        campaign = campaign_section(record, r),
         sizes = campaign_sizes(r),
         rattle = HELD_RATTLE_RAD,
         pre_roll = PRE_ROLL_S * 1e3,
