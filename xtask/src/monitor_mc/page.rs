@@ -15,13 +15,17 @@ pub const CAMPAIGN_RECORD: &str = "docs/results/mc-nominal-campaign.json";
 /// The campaign of [`CAMPAIGN_RECORD`] as planned: nominal runs, shards, seed.
 pub const CAMPAIGN_PLAN: (u64, u64, u64) = (100_000, 20, 101);
 
-/// The commands that made [`CAMPAIGN_RECORD`]: the planned shards two at a time (one per core),
-/// then the merge (`--prefix` when only the first shards were run).
+/// The shards of the plan's campaign that were run (`--shard` values; the last two split the
+/// fifth twentieth over both cores when the rest could not finish in the session's time).
+pub const CAMPAIGN_SHARDS_RUN: [&str; 6] = ["0/20", "1/20", "2/20", "3/20", "8/40", "9/40"];
+
+/// The commands that made [`CAMPAIGN_RECORD`]: the shards two at a time (one per core), then
+/// the merge (`--prefix` when they cover only the first runs of the plan).
 pub fn campaign_command(prefix: bool) -> String {
-    let (runs, shards, seed) = CAMPAIGN_PLAN;
+    let (runs, _, seed) = CAMPAIGN_PLAN;
     format!(
-        "seq 0 {} | xargs -P 2 -I K nice -n 5 cargo xtask monitor-mc --runs {runs} --fault-runs 0 --seed {seed} --threads 1 --shard K/{shards} --out part-K.json\ncargo xtask monitor-mc merge part-*.json{} --no-doc --out {CAMPAIGN_RECORD}",
-        shards - 1,
+        "printf '%s\\n' {} | xargs -P 2 -I S sh -c 'nice -n 5 cargo xtask monitor-mc --runs {runs} --fault-runs 0 --seed {seed} --threads 1 --shard S --out part-$(echo S | tr / -).json'\ncargo xtask monitor-mc merge part-*.json{} --no-doc --out {CAMPAIGN_RECORD}",
+        CAMPAIGN_SHARDS_RUN.join(" "),
         if prefix { " --prefix" } else { "" }
     )
 }
@@ -201,11 +205,11 @@ fn campaign_section(record: Option<&Value>, current: &Value) -> String {
     let runs = c["runs"].as_u64().unwrap_or(0);
     let done = if runs < planned {
         format!(
-            "the first {} of its {shards} shards finished in the time the session had, merged with \
-             `--prefix` into the campaign of their {runs} runs (the same report as \
-             `cargo xtask monitor-mc --runs {runs} --fault-runs 0 --seed {}`: a run's draws do not \
-             depend on the campaign's size)",
-            runs * shards / planned,
+            "the shards run in the time the session had (`--shard` {}) hold its first {runs} \
+             runs; merged with `--prefix` into the campaign of those runs (the same report as \
+             `cargo xtask monitor-mc --runs {runs} --fault-runs 0 --seed {}`: a run's draws do \
+             not depend on the campaign's size nor on its cut)",
+            CAMPAIGN_SHARDS_RUN.join(", "),
             c["seed"],
         )
     } else {
