@@ -15,18 +15,23 @@ pub const CAMPAIGN_RECORD: &str = "docs/results/mc-nominal-campaign.json";
 /// The campaign of [`CAMPAIGN_RECORD`] as planned: nominal runs, shards, seed.
 pub const CAMPAIGN_PLAN: (u64, u64, u64) = (100_000, 20, 101);
 
-/// The shards of the plan's campaign that were run (`--shard` values; the last two split the
-/// fifth twentieth over both cores when the rest could not finish in the session's time).
-pub const CAMPAIGN_SHARDS_RUN: [&str; 6] = ["0/20", "1/20", "2/20", "3/20", "8/40", "9/40"];
+/// The `--shard` values run of the plan's campaign to cover its first `runs` runs: the first
+/// four twentieths, then fortieths (two at a time finish sooner, which the session's time
+/// asked for when the machine was shared).
+pub fn campaign_shards(runs: u64) -> Vec<String> {
+    let twentieths = (0..4).map(|k| format!("{k}/20"));
+    let fortieths = (8..runs * 40 / CAMPAIGN_PLAN.0).map(|k| format!("{k}/40"));
+    twentieths.chain(fortieths).collect()
+}
 
-/// The commands that made [`CAMPAIGN_RECORD`]: the shards two at a time (one per core), then
-/// the merge (`--prefix` when they cover only the first runs of the plan).
-pub fn campaign_command(prefix: bool) -> String {
-    let (runs, _, seed) = CAMPAIGN_PLAN;
+/// The commands that made [`CAMPAIGN_RECORD`] of `runs` runs: the shards two at a time (one per
+/// core), then the merge (`--prefix` when they cover only the first runs of the plan).
+pub fn campaign_command(runs: u64) -> String {
+    let (planned, _, seed) = CAMPAIGN_PLAN;
     format!(
-        "printf '%s\\n' {} | xargs -P 2 -I S sh -c 'nice -n 5 cargo xtask monitor-mc --runs {runs} --fault-runs 0 --seed {seed} --threads 1 --shard S --out part-$(echo S | tr / -).json'\ncargo xtask monitor-mc merge part-*.json{} --no-doc --out {CAMPAIGN_RECORD}",
-        CAMPAIGN_SHARDS_RUN.join(" "),
-        if prefix { " --prefix" } else { "" }
+        "printf '%s\\n' {} | xargs -P 2 -I S sh -c 'nice -n 5 cargo xtask monitor-mc --runs {planned} --fault-runs 0 --seed {seed} --threads 1 --shard S --out part-$(echo S | tr / -).json'\ncargo xtask monitor-mc merge part-*.json{} --no-doc --out {CAMPAIGN_RECORD}",
+        campaign_shards(runs).join(" "),
+        if runs < planned { " --prefix" } else { "" }
     )
 }
 
@@ -209,7 +214,7 @@ fn campaign_section(record: Option<&Value>, current: &Value) -> String {
              runs; merged with `--prefix` into the campaign of those runs (the same report as \
              `cargo xtask monitor-mc --runs {runs} --fault-runs 0 --seed {}`: a run's draws do \
              not depend on the campaign's size nor on its cut)",
-            CAMPAIGN_SHARDS_RUN.join(", "),
+            campaign_shards(runs).join(", "),
             c["seed"],
         )
     } else {
@@ -227,7 +232,7 @@ fn campaign_section(record: Option<&Value>, current: &Value) -> String {
         c["seed"],
         c["plant_family"].as_str().unwrap_or(""),
         c["config_digest"].as_str().unwrap_or(""),
-        campaign_command(runs < planned),
+        campaign_command(runs),
         false_alarm_line(c),
     )
 }

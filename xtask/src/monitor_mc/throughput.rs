@@ -33,11 +33,9 @@ fn cpu_s() -> f64 {
     let stat = std::fs::read_to_string("/proc/self/stat").unwrap_or_default();
     // Fields after the command's closing parenthesis; utime and stime are the 12th and 13th.
     let rest = stat.rsplit_once(')').map_or("", |(_, r)| r);
-    let f: Vec<f64> = rest
-        .split_whitespace()
-        .filter_map(|x| x.parse().ok())
-        .collect();
-    (f.get(11).copied().unwrap_or(0.0) + f.get(12).copied().unwrap_or(0.0)) / 100.0
+    let f: Vec<&str> = rest.split_whitespace().collect();
+    let field = |i: usize| f.get(i).and_then(|x| x.parse::<f64>().ok()).unwrap_or(0.0);
+    (field(11) + field(12)) / 100.0
 }
 
 /// Runs per wall-clock second and per CPU second of `draws` on `threads` workers.
@@ -89,7 +87,12 @@ pub fn main(a: &ThroughputArgs) -> Result<(), String> {
     );
     for (nodes, per) in [(1, cores), (1, 32), (10, 32), (100, 32)] {
         let hours = 1e6 / (one_cpu * (nodes * per) as f64) / 3600.0;
-        let _ = writeln!(s, "| {nodes} | {per} | {hours:.2} h |");
+        let wall = if hours >= 1.0 {
+            format!("{hours:.1} h")
+        } else {
+            format!("{:.1} min", hours * 60.0)
+        };
+        let _ = writeln!(s, "| {nodes} | {per} | {wall} |");
     }
     let path = workspace_root().join("docs/results/mc-throughput.md");
     std::fs::write(&path, &s).map_err(|e| format!("{}: {e}", path.display()))?;
