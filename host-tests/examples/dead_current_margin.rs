@@ -9,7 +9,7 @@
 //! `cargo run --release -p host-tests --example dead_current_margin -- [RUNS] [SEED]`
 //! (defaults 2000 and 2026). docs/decisions.md, "Dead current reading check", quotes it.
 
-use host_tests::mc::{draw, draw_trace};
+use host_tests::mc::{draw_legacy as draw, draw_trace};
 use noback::monitor::Config;
 use noback::sensors::SensorConfig;
 

@@ -12,7 +12,7 @@
 //! 500 and 2026).
 
 use host_tests::accuracy::{compare, detection_latency_s, manifest_time, run_monitor};
-use host_tests::mc::{draw, draw_trace, scene_after, Context, Draw, PRE_ROLL_S};
+use host_tests::mc::{draw_legacy as draw, draw_trace, scene_after, Context, Draw, PRE_ROLL_S};
 use noback::monitor::Config;
 use noback_twin::fault::FaultKind;
 use noback_twin::model::Sample;

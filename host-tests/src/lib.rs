@@ -9,3 +9,4 @@ pub mod accuracy;
 pub mod fuzz;
 pub mod mc;
 pub mod robustness;
+pub mod stats;

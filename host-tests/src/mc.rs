@@ -153,6 +153,10 @@ fn scale_all(m: &mut Mechanism, rng: &mut Rng) {
     s(&mut m.restitution);
 }
 
+/// The name of the plant family [`draw`] draws from (recorded in every part of a sharded
+/// campaign): the physical reading, Table 2 ± 10 %, the five scene kinds below.
+pub const PLANT_FAMILY: &str = "physical-default";
+
 /// The scene kinds of the nominal and fault draws.
 pub const SCENE_KINDS: [SceneKind; 5] = [
     SceneKind::ReverseLoad,
@@ -162,18 +166,41 @@ pub const SCENE_KINDS: [SceneKind; 5] = [
     SceneKind::ContinuousClosing,
 ];
 
+/// The random stream of one run: a generator whose state is the SplitMix hash of (`seed`,
+/// stream, `index`), the stream being 0 for a nominal run and 1 + the kind's place in
+/// [`FAULT_KINDS`] for a fault run. Each run's draws depend on that triple alone, so a
+/// campaign cut into shards draws exactly what it draws whole.
+pub fn run_rng(seed: u64, index: u64, fault: Option<FaultKind>) -> Rng {
+    let hash = |x: u64| Rng::new(x).next_u64();
+    Rng::new(hash(hash(hash(seed) ^ stream(fault)) ^ index))
+}
+
+fn stream(fault: Option<FaultKind>) -> u64 {
+    fault.map_or(0, |k| {
+        1 + FAULT_KINDS.iter().position(|f| *f == k).unwrap_or(0) as u64
+    })
+}
+
 /// Draws run `index` of a campaign: deterministic in (`seed`, `index`, `fault`).
 pub fn draw(seed: u64, index: u64, fault: Option<FaultKind>) -> Draw {
+    draw_from(&SCENE_KINDS, run_rng(seed, index, fault), index, fault)
+}
+
+/// A draw of the campaigns before issue 21, whose generator started at
+/// `seed ^ index·φ ^ stream << 56` (nearby runs' streams overlapped), with the scene kind drawn
+/// among `kinds` (before continuous closing joined: `&SCENE_KINDS[..4]`). The tests and
+/// measurements that name a run of those campaigns reproduce it with this.
+pub fn draw_among(kinds: &[SceneKind], seed: u64, index: u64, fault: Option<FaultKind>) -> Draw {
+    let rng = Rng::new(seed ^ index.wrapping_mul(0x9E37_79B9_7F4A_7C15) ^ (stream(fault) << 56));
+    draw_from(kinds, rng, index, fault)
+}
+
+/// [`draw_among`] the five scene kinds: run `index` of a campaign before issue 21.
+pub fn draw_legacy(seed: u64, index: u64, fault: Option<FaultKind>) -> Draw {
     draw_among(&SCENE_KINDS, seed, index, fault)
 }
 
-/// [`draw`] with the scene kind drawn among `kinds` (the campaigns before continuous closing
-/// joined drew among the first four: their draws are reproduced with `&SCENE_KINDS[..4]`).
-pub fn draw_among(kinds: &[SceneKind], seed: u64, index: u64, fault: Option<FaultKind>) -> Draw {
-    let salt = fault.map_or(0, |k| {
-        1 + FAULT_KINDS.iter().position(|f| *f == k).unwrap_or(0) as u64
-    });
-    let mut rng = Rng::new(seed ^ index.wrapping_mul(0x9E37_79B9_7F4A_7C15) ^ (salt << 56));
+fn draw_from(kinds: &[SceneKind], mut rng: Rng, index: u64, fault: Option<FaultKind>) -> Draw {
     let kind = kinds
         .get((rng.next_u64() % kinds.len().max(1) as u64) as usize)
         .copied()

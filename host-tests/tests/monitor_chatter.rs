@@ -13,7 +13,7 @@
 //! and the gentle engagement cycle at light loads.
 
 use host_tests::accuracy::{compare, monitor_on_scene, run_monitor};
-use host_tests::mc::{draw, draw_trace};
+use host_tests::mc::{draw_legacy as draw, draw_trace};
 use noback::monitor::Config;
 use noback_twin::fault::FaultKind;
 use noback_twin::reading::Reading;

@@ -20,6 +20,7 @@ mod reliability;
 mod replay;
 mod run;
 mod shell;
+mod slurm_test;
 mod snapshot;
 mod test;
 #[cfg(test)]

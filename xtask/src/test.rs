@@ -1,6 +1,7 @@
 //! `cargo xtask test` — every test, in the order that fails fastest:
 //! format, clippy (host and each thumb target), host tests (library, host-tests, twin, tidy),
-//! then under QEMU on M0, M3 and M4F: the defmt-test target tests and the release firmware.
+//! a sharded Monte Carlo on a single-node Slurm (`slurm_test`), then under QEMU on M0, M3 and
+//! M4F: the defmt-test target tests and the release firmware.
 //! The digest each target prints is compared here with the one computed natively: that is the
 //! bit-identity check, made by the xtask rather than asserted by the target about itself.
 
@@ -88,6 +89,8 @@ pub fn main(a: &TestArgs) -> Result<i32, String> {
     shell::run(cargo().args(["test", "--workspace"]))?;
     section("pages reproduce (reliability against its committed page, paper and monitor-mc twice)");
     crate::pages::reproduce()?;
+    section("Slurm: a sharded Monte Carlo as a job array, merged = unsharded");
+    crate::slurm_test::stage()?;
 
     let host_digest = noback::vectors::run().digest;
     let mut rows = Vec::new();

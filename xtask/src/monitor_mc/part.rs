@@ -1,0 +1,315 @@
+//! A shard's result file and the merge of shards: each part records the campaign it belongs to
+//! (seed, plant family, the monitor's configuration digest, pre-roll, the campaign's size) and
+//! the runs it covers; merge refuses parts that do not belong together, overlap or leave gaps.
+
+use host_tests::mc::{Context, Outcome, FAULT_KINDS};
+use noback::digest::Fnv1a;
+use noback::monitor::Config;
+use serde::{Deserialize, Serialize};
+use std::ops::Range;
+
+/// The part files' format tag.
+pub const FORMAT: &str = "noback-monitor-mc-part/1";
+
+/// What every part of one campaign shares.
+#[derive(Serialize, Deserialize, Clone, Debug, PartialEq)]
+pub struct Campaign {
+    pub seed: u64,
+    pub plant_family: String,
+    pub config_digest: String,
+    pub pre_roll_s: f64,
+    /// The monitor's settling after a seeded power-on (s), the one setting an ablation changes.
+    pub power_on_settle_s: f64,
+    /// Nominal runs of the whole campaign.
+    pub runs: u64,
+    /// Runs per fault kind of the whole campaign.
+    pub fault_runs: u64,
+}
+
+/// One fault run's outcome.
+#[derive(Serialize, Deserialize, Clone, Debug, PartialEq)]
+pub struct FaultRun {
+    pub kind: String,
+    pub index: u64,
+    pub manifested: bool,
+    pub latency_s: Option<f64>,
+    pub context: Option<String>,
+    pub false_flags: usize,
+    pub error: Option<String>,
+}
+
+/// A nominal run the twin could not run.
+#[derive(Serialize, Deserialize, Clone, Debug, PartialEq)]
+pub struct RunError {
+    pub index: u64,
+    pub error: String,
+}
+
+/// One shard's result.
+#[derive(Serialize, Deserialize, Clone, Debug, PartialEq)]
+pub struct Part {
+    pub format: String,
+    pub campaign: Campaign,
+    /// `[K, N]` as given to `--shard` (for reading; the ranges are what merge checks).
+    pub shard: [u64; 2],
+    /// The nominal run indices covered, `[start, end)`.
+    pub nominal: [u64; 2],
+    /// The run indices covered of every fault kind, `[start, end)`.
+    pub faults: [u64; 2],
+    /// Nominal runs with any flag.
+    pub false_alarm_runs: Vec<u64>,
+    pub nominal_errors: Vec<RunError>,
+    /// Every fault run, kind by kind in `FAULT_KINDS` order, each by index.
+    pub fault_runs: Vec<FaultRun>,
+}
+
+/// The digest of the monitor's configuration (FNV-1a over the bytes of its `Debug` form, which
+/// prints every field and every float exactly).
+pub fn config_digest(config: &Config) -> String {
+    let mut d = Fnv1a::new();
+    for b in format!("{config:?}").bytes() {
+        d.push(u32::from(b));
+    }
+    format!("{:#010x}", d.value())
+}
+
+/// The indices shard `k` of `n` covers out of `total`: the `k`-th of `n` near-equal slices.
+pub fn slice(total: u64, k: u64, n: u64) -> Range<u64> {
+    let at = |i: u64| (u128::from(total) * u128::from(i) / u128::from(n.max(1))) as u64;
+    at(k)..at(k + 1)
+}
+
+fn context_tag(c: Context) -> &'static str {
+    match c {
+        Context::Settling => "settling",
+        Context::ShortDrive => "short_drive",
+        Context::ContinuousClosing => "continuous_closing",
+        Context::Other => "other",
+    }
+}
+
+impl Part {
+    /// The part of `outcomes`: the nominal runs `nominal` then, for each fault kind, the runs
+    /// `faults`, in that order.
+    pub fn new(
+        campaign: Campaign,
+        shard: [u64; 2],
+        nominal: Range<u64>,
+        faults: Range<u64>,
+        outcomes: &[Outcome],
+    ) -> Part {
+        let (nom, flt) = outcomes.split_at((nominal.end - nominal.start) as usize);
+        let fault_indices = FAULT_KINDS.iter().flat_map(|_| faults.clone());
+        Part {
+            format: FORMAT.into(),
+            campaign,
+            shard,
+            nominal: [nominal.start, nominal.end],
+            faults: [faults.start, faults.end],
+            false_alarm_runs: nominal
+                .clone()
+                .zip(nom)
+                .filter(|(_, o)| o.error.is_none() && o.false_flags > 0)
+                .map(|(i, _)| i)
+                .collect(),
+            nominal_errors: nominal
+                .zip(nom)
+                .filter_map(|(index, o)| {
+                    let error = o.error.clone()?;
+                    Some(RunError { index, error })
+                })
+                .collect(),
+            fault_runs: fault_indices
+                .zip(flt)
+                .map(|(index, o)| FaultRun {
+                    kind: o.fault.map(|k| format!("{k:?}")).unwrap_or_default(),
+                    index,
+                    manifested: o.manifested,
+                    latency_s: o.latency_s,
+                    context: o.context.map(|c| context_tag(c).into()),
+                    false_flags: o.false_flags,
+                    error: o.error.clone(),
+                })
+                .collect(),
+        }
+    }
+}
+
+fn outcome_of(r: &FaultRun) -> Result<Outcome, String> {
+    let fault = FAULT_KINDS
+        .iter()
+        .copied()
+        .find(|k| format!("{k:?}") == r.kind)
+        .ok_or_else(|| format!("unknown fault kind `{}`", r.kind))?;
+    let context = match r.context.as_deref() {
+        None => None,
+        Some(tag) => Some(
+            Context::ALL
+                .into_iter()
+                .find(|c| context_tag(*c) == tag)
+                .ok_or_else(|| format!("unknown context `{tag}`"))?,
+        ),
+    };
+    Ok(Outcome {
+        fault: Some(fault),
+        latency_s: r.latency_s,
+        manifested: r.manifested,
+        context,
+        false_flags: r.false_flags,
+        error: r.error.clone(),
+    })
+}
+
+/// Checks that `ranges` (name, `[start, end)`) tile `0..total` exactly, or with `prefix` some
+/// `0..end` with end ≤ total; returns the end.
+fn tile(
+    what: &str,
+    ranges: &mut [(&str, [u64; 2])],
+    total: u64,
+    prefix: bool,
+) -> Result<u64, String> {
+    ranges.sort_by_key(|(_, r)| (r[0], r[1]));
+    let mut end = 0;
+    let mut last = "";
+    for (name, r) in ranges.iter() {
+        if r[0] > r[1] || r[1] > total {
+            return Err(format!(
+                "{name}: {what} runs {}..{} are not within 0..{total}",
+                r[0], r[1]
+            ));
+        }
+        if r[0] < end {
+            return Err(format!(
+                "{name}: {what} runs {}..{} overlap {last}'s",
+                r[0], r[1]
+            ));
+        }
+        if r[0] > end {
+            return Err(format!(
+                "{name}: no part holds the {what} runs {end}..{} before it",
+                r[0]
+            ));
+        }
+        end = r[1];
+        last = name;
+    }
+    if end < total && !prefix {
+        return Err(format!(
+            "{last}: no part holds the {what} runs {end}..{total} after it"
+        ));
+    }
+    Ok(end)
+}
+
+/// Checks one part against the campaign and its own ranges.
+fn check(name: &str, p: &Part, first: &(String, Campaign)) -> Result<(), String> {
+    if p.format != FORMAT {
+        return Err(format!("{name}: format `{}`, not `{FORMAT}`", p.format));
+    }
+    let c = &p.campaign;
+    let f = &first.1;
+    let differs = |what: &str, a: String, b: String| {
+        Err(format!("{name}: {what} {a} differs from {}'s {b}", first.0))
+    };
+    if c.seed != f.seed {
+        return differs("seed", c.seed.to_string(), f.seed.to_string());
+    }
+    if c.plant_family != f.plant_family {
+        return differs(
+            "plant family",
+            c.plant_family.clone(),
+            f.plant_family.clone(),
+        );
+    }
+    if c.config_digest != f.config_digest {
+        return differs(
+            "configuration digest",
+            c.config_digest.clone(),
+            f.config_digest.clone(),
+        );
+    }
+    if c.power_on_settle_s.to_bits() != f.power_on_settle_s.to_bits() {
+        let (a, b) = (c.power_on_settle_s, f.power_on_settle_s);
+        return differs("power-on settling", a.to_string(), b.to_string());
+    }
+    if c.pre_roll_s.to_bits() != f.pre_roll_s.to_bits() {
+        return differs(
+            "pre-roll",
+            c.pre_roll_s.to_string(),
+            f.pre_roll_s.to_string(),
+        );
+    }
+    if (c.runs, c.fault_runs) != (f.runs, f.fault_runs) {
+        return differs(
+            "campaign size",
+            format!("{}+{}", c.runs, c.fault_runs),
+            format!("{}+{}", f.runs, f.fault_runs),
+        );
+    }
+    let in_nominal = |i: &u64| (p.nominal[0]..p.nominal[1]).contains(i);
+    if !p.false_alarm_runs.iter().all(in_nominal)
+        || !p.nominal_errors.iter().all(|e| in_nominal(&e.index))
+    {
+        return Err(format!("{name}: names a nominal run outside its range"));
+    }
+    let expected = FAULT_KINDS
+        .iter()
+        .flat_map(|k| (p.faults[0]..p.faults[1]).map(move |i| (format!("{k:?}"), i)));
+    let listed = p.fault_runs.iter().map(|r| (r.kind.clone(), r.index));
+    if p.faults[0] > p.faults[1] || !expected.eq(listed) {
+        return Err(format!(
+            "{name}: its fault runs are not its range's, kind by kind"
+        ));
+    }
+    Ok(())
+}
+
+/// The campaign and its outcomes (nominal, then each fault kind, by index) from `parts`
+/// (name, part); an error names the part at fault. With `prefix`, parts that cover only the
+/// first runs of their campaign give the campaign of that size (a run's draws do not depend
+/// on the campaign's size: the same outcomes as the smaller campaign run whole).
+pub fn merge(parts: &[(String, Part)], prefix: bool) -> Result<(Campaign, Vec<Outcome>), String> {
+    let Some((first_name, first)) = parts.first() else {
+        return Err("merge needs at least one part".into());
+    };
+    let reference = (first_name.clone(), first.campaign.clone());
+    for (name, p) in parts {
+        check(name, p, &reference)?;
+    }
+    let mut c = reference.1;
+    let mut ranges: Vec<_> = parts.iter().map(|(n, p)| (n.as_str(), p.nominal)).collect();
+    c.runs = tile("nominal", &mut ranges, c.runs, prefix)?;
+    let mut ranges: Vec<_> = parts.iter().map(|(n, p)| (n.as_str(), p.faults)).collect();
+    c.fault_runs = tile("fault", &mut ranges, c.fault_runs, prefix)?;
+
+    let mut nominal = vec![
+        Outcome {
+            fault: None,
+            latency_s: None,
+            manifested: false,
+            context: None,
+            false_flags: 0,
+            error: None,
+        };
+        c.runs as usize
+    ];
+    let mut faults: Vec<Option<Outcome>> = vec![None; FAULT_KINDS.len() * c.fault_runs as usize];
+    for (name, p) in parts {
+        for &i in &p.false_alarm_runs {
+            nominal[i as usize].false_flags = 1;
+        }
+        for e in &p.nominal_errors {
+            nominal[e.index as usize].error = Some(e.error.clone());
+        }
+        for r in &p.fault_runs {
+            let o = outcome_of(r).map_err(|e| format!("{name}: {e}"))?;
+            let k = FAULT_KINDS
+                .iter()
+                .position(|k| Some(*k) == o.fault)
+                .unwrap_or(0);
+            faults[k * c.fault_runs as usize + r.index as usize] = Some(o);
+        }
+    }
+    nominal.extend(faults.into_iter().flatten());
+    Ok((c, nominal))
+}

@@ -1,0 +1,127 @@
+//! A campaign cut into 2 or 3 shards, each run on a different number of threads and merged in
+//! any order, gives the unsharded campaign's report and page byte for byte; merge refuses parts
+//! that do not belong together.
+
+use super::*;
+
+const RUNS: u64 = 7;
+const FAULT_RUNS: u64 = 2;
+
+fn campaign() -> (Setup, Campaign) {
+    let setup = Setup::default();
+    (setup, campaign_of(&setup, 5, RUNS, FAULT_RUNS))
+}
+
+/// A part as a merge reads it: through its file's text.
+fn through_text(p: &Part) -> Part {
+    serde_json::from_str(&serde_json::to_string(p).unwrap()).unwrap()
+}
+
+fn report(parts: &[(String, Part)]) -> (serde_json::Value, String) {
+    let (c, outcomes) = part::merge(parts, false).expect("merge");
+    report_of(&c, &outcomes, Setup::default()).expect("report")
+}
+
+#[test]
+fn shards_merge_to_the_unsharded_campaign_byte_for_byte() {
+    let (setup, c) = campaign();
+    let whole = through_text(&run_part(&setup, c.clone(), 0, 1, 2));
+    let (json, page) = report(&[("whole".into(), whole)]);
+    assert_eq!(json["nominal_runs"], RUNS);
+    assert!(json["false_alarm_rate"]["ci95"][1].as_f64().is_some());
+    for n in [2, 3] {
+        let mut parts: Vec<(String, Part)> = (0..n)
+            .map(|k| {
+                let p = run_part(&setup, c.clone(), k, n, 1 + k as usize);
+                (format!("part-{k}"), through_text(&p))
+            })
+            .collect();
+        parts.reverse();
+        let (j, p) = report(&parts);
+        assert_eq!(j.to_string(), json.to_string(), "{n} shards");
+        assert_eq!(p, page, "{n} shards");
+    }
+}
+
+#[test]
+fn merge_refuses_parts_that_do_not_belong_together() {
+    let (setup, c) = campaign();
+    // Parts of no runs at all: the checks are on the records, not the outcomes.
+    let empty = |c: &Campaign, nominal: std::ops::Range<u64>, faults: std::ops::Range<u64>| {
+        let n = (nominal.end - nominal.start) as usize;
+        let f = (faults.end - faults.start) as usize * FAULT_KINDS.len();
+        let outcomes: Vec<_> = (0..n)
+            .map(|_| None)
+            .chain((0..f).map(|i| Some(FAULT_KINDS[i / (f / FAULT_KINDS.len())])))
+            .map(|fault| host_tests::mc::Outcome {
+                fault,
+                latency_s: None,
+                manifested: false,
+                context: None,
+                false_flags: 0,
+                error: None,
+            })
+            .collect();
+        Part::new(c.clone(), [0, 1], nominal, faults, &outcomes)
+    };
+    let a = empty(&c, 0..4, 0..1);
+    let b = empty(&c, 4..RUNS, 1..FAULT_RUNS);
+    assert!(part::merge(&[("a".into(), a.clone()), ("b".into(), b.clone())], false).is_ok());
+    let mut other = c.clone();
+    other.seed = 6;
+    let refused = |parts: &[(String, Part)], names: &str| {
+        let e = part::merge(parts, false).expect_err("merged");
+        assert!(e.starts_with(names), "{e}");
+    };
+    refused(
+        &[
+            ("a".into(), a.clone()),
+            ("c".into(), empty(&other, 4..RUNS, 1..FAULT_RUNS)),
+        ],
+        "c: seed",
+    );
+    let mut family = c.clone();
+    family.plant_family = "other".into();
+    refused(
+        &[
+            ("a".into(), a.clone()),
+            ("d".into(), empty(&family, 4..RUNS, 1..FAULT_RUNS)),
+        ],
+        "d: plant family",
+    );
+    let mut digest = c.clone();
+    digest.config_digest = part::config_digest(&{
+        let mut s = setup;
+        s.config.thresholds.power_on_settle_s += 0.01;
+        s.config
+    });
+    refused(
+        &[
+            ("a".into(), a.clone()),
+            ("e".into(), empty(&digest, 4..RUNS, 1..FAULT_RUNS)),
+        ],
+        "e: configuration digest",
+    );
+    refused(
+        &[
+            ("a".into(), a.clone()),
+            ("f".into(), empty(&c, 3..RUNS, 1..FAULT_RUNS)),
+        ],
+        "f: nominal runs 3..7 overlap",
+    );
+    refused(
+        &[
+            ("a".into(), a.clone()),
+            ("g".into(), empty(&c, 5..RUNS, 1..FAULT_RUNS)),
+        ],
+        "g: no part holds the nominal runs 4..5",
+    );
+    refused(
+        &[("a".into(), a.clone())],
+        "a: no part holds the nominal runs 4..7 after it",
+    );
+    assert_eq!(
+        part::merge(&[("a".into(), a)], true).map(|(c, _)| c.runs),
+        Ok(4)
+    );
+}
