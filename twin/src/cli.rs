@@ -8,7 +8,7 @@
 
 use crate::metrics::{self, Metrics};
 use crate::model::Sample;
-use crate::paper_table;
+use crate::paper_page;
 use crate::reading::Reading;
 use crate::scene::{Scene, SceneKind};
 use crate::sensing;
@@ -313,8 +313,9 @@ pub fn default_paper_doc() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../docs/paper-comparison.md")
 }
 
-/// `paper [--json] [--out FILE] [--tolerance TOL]`: run the paper's scenes under both readings
-/// and write docs/paper-comparison.md.
+/// `paper [--json] [--out FILE] [--tolerance TOL]`: the paper protocol (fixed tolerances) and
+/// every figure of both readings (at TOL); writes docs/paper-comparison.md, or with `--json`
+/// prints JSON and writes nothing.
 pub fn paper_main(args: &[String]) -> i32 {
     let mut json = false;
     let mut out = default_paper_doc();
@@ -338,21 +339,22 @@ pub fn paper_main(args: &[String]) -> i32 {
             }
         }
     }
-    let table = match paper_table::build(tolerance) {
+    let page = match paper_page::build(tolerance) {
         Ok(t) => t,
         Err(e) => return fail(&format!("paper scenes: {e}")),
     };
-    if let Err(e) = std::fs::write(&out, table.markdown()) {
-        return fail(&format!("cannot write {}: {e}", out.display()));
-    }
     if json {
-        match serde_json::to_string(&table) {
+        // JSON goes to stdout only; the page is written only without --json.
+        match serde_json::to_string(&page) {
             Ok(s) => println!("{s}"),
             Err(e) => return fail(&format!("json: {e}")),
         }
-    } else {
-        print!("{}", table.markdown());
-        println!("\nwrote {}", out.display());
+        return 0;
     }
+    if let Err(e) = std::fs::write(&out, page.markdown()) {
+        return fail(&format!("cannot write {}: {e}", out.display()));
+    }
+    print!("{}", page.markdown());
+    println!("\nwrote {}", out.display());
     0
 }

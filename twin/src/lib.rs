@@ -9,6 +9,8 @@ pub mod friction;
 pub mod metrics;
 pub mod model;
 pub mod pack;
+pub mod paper_page;
+pub mod paper_protocol;
 pub mod paper_table;
 pub mod reading;
 pub mod scene;
