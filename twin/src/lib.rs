@@ -4,6 +4,7 @@
 
 pub mod cli;
 pub mod contact;
+pub mod convergence;
 pub mod fault;
 pub mod friction;
 pub mod metrics;
@@ -12,6 +13,7 @@ pub mod pack;
 pub mod paper_page;
 pub mod paper_protocol;
 pub mod paper_table;
+pub mod ramp_friction;
 pub mod reading;
 pub mod scene;
 pub mod scene_file;
