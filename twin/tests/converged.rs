@@ -11,7 +11,10 @@ use noback_twin::sim;
 
 #[test]
 fn default_tolerance_matches_the_converged_references() {
-    let path = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/reference/converged.json");
+    let path = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/tests/reference/converged.json"
+    );
     let text = std::fs::read_to_string(path).unwrap();
     let refs: Vec<Entry> = serde_json::from_str(&text).unwrap();
     assert!(refs.len() > 50, "{} entries", refs.len());

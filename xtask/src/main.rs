@@ -46,11 +46,11 @@ pub const COMMANDS: &[(&str, &str)] = &[
     ),
     (
         "twin-bench",
-        "[--tolerance TOL] [--no-scipy]: twin speed against scipy Radau; writes docs/results/twin-speed.md",
+        "[--tolerance TOL] [--no-scipy] [--json]: twin and scipy Radau against the converged references; writes docs/results/twin-speed.md",
     ),
     (
         "paper",
-        "[--json]: the paper's scenes under both readings; writes docs/paper-comparison.md",
+        "[--json]: the paper protocol and both readings; writes docs/paper-comparison.md (--json: prints only)",
     ),
     (
         "sweep",
