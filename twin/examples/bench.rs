@@ -113,7 +113,8 @@ fn main() {
             None
         };
         let py_wall = py.get("wall_s").and_then(Value::as_f64);
-        let matched = |e: Option<f64>| e.is_none_or(|e| e <= convergence::SETTLE);
+        // Matched: a compared metric exists and both sides hold it within 1 % of the reference.
+        let matched = |e: Option<f64>| e.is_some_and(|e| e <= convergence::SETTLE);
         let ratio = match py_wall {
             Some(w) if matched(twin_err) && matched(py_err) => Some(w / best),
             _ => None,
@@ -148,6 +149,7 @@ fn main() {
                 pct(py_err),
                 match (ratio, py_wall) {
                     (Some(r), _) => format!("{r:.0}×"),
+                    (None, Some(_)) if twin_err.is_none() => "— (no compared metric)".into(),
                     (None, Some(_)) => "— (not matched)".into(),
                     (None, None) => "—".into(),
                 },

@@ -61,7 +61,8 @@ pub fn main(args: &[String]) -> Result<i32, String> {
          from one run on {cpu} ({cores} cores, shared): a benchmark, not a test, and they change \
          from run to run. Errors are against the converged references \
          (`twin/tests/reference/converged.json`, tolerance 1e-10; braking time and angle, the \
-         metrics both sides report); a speed ratio is given only where both sides are within 1 %.\n\n{table}",
+         metrics both sides report); a speed ratio is given only where both sides hold them within 1 % (continuous closing has \
+         neither, so no ratio).\n\n{table}",
         args.join(" ")
     );
     let path = workspace_root()
