@@ -8,7 +8,7 @@ located events (contact onset records the approach speed; slip->stick at zero sp
 Used by `cargo run --release -p noback-twin --example bench` to compare speed at matched
 tolerance. Prints one JSON object.
 
-usage: radau.py SCENE [--tolerance TOL]
+usage: radau.py SCENE [--tolerance TOL] [--record-all]
 """
 import json
 import math
@@ -26,6 +26,7 @@ R, R_MS, R_MD, R_MR = 0.02, 0.012, 0.01, 0.01
 R1, R2, GP1, GP2 = 0.0285, 0.0375, 0.2e-3, 0.5e-3
 THETA, NF, MU_S, MU_D, E = math.pi / 4, 3, 0.3, 0.17, 0.5
 G = 9.81
+RECORD_ALL = False  # set from the command line
 FLOOR = 0.01          # approach-speed floor (m/s)
 KP = 50.0             # servo gain (N m s/rad)
 T_LIM = 25.0 * 0.06 * 30 * 0.9
@@ -149,8 +150,12 @@ class Model:
         else:
             self.mode = FWD if req > 0 else BWD
 
-    def on_event(self, y):
+    def on_event(self, y, fired):
+        # As the twin: only the contacts whose event fired re-record their approach speed
+        # (`--record-all`: every touching contact, the script's former rule).
         for k, c in enumerate(CONTACTS):
+            if not RECORD_ALL and k not in fired:
+                continue
             d, v = self.pen(c, y)
             if abs(d) < 1e-12 or d > 0:
                 self.approach[k] = max(abs(v), FLOOR) if (d >= -1e-12 and v > 0) else FLOOR
@@ -208,6 +213,7 @@ def run(scene, tol):
                 grid_a.append(ys[TS])
                 next_sample += 1e-4
             y = sol.y[:, -1].copy()
+            fired = {i for i, te in enumerate(sol.t_events or []) if len(te)}
             stalled = t_end - t < 1e-12
             t = t_end
             if sol.status == 1 and stalled:
@@ -216,11 +222,11 @@ def run(scene, tol):
                 nfev += nudge.nfev
                 y = nudge.y[:, -1].copy()
                 t = nudge.t[-1]
-                m.on_event(y)
+                m.on_event(y, fired)
             elif sol.status == 1:
                 nevents += 1
                 # step just past the root so the sign has changed
-                m.on_event(y)
+                m.on_event(y, fired)
             elif sol.status < 0:
                 raise SystemExit(sol.message)
         if release is not None and abs(b - release) < 1e-12:
@@ -242,6 +248,7 @@ def run(scene, tol):
 
 if __name__ == "__main__":
     args = sys.argv[1:]
+    RECORD_ALL = "--record-all" in args
     tol = 1e-5
     if "--tolerance" in args:
         tol = float(args[args.index("--tolerance") + 1])

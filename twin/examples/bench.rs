@@ -1,12 +1,42 @@
-//! Speed benchmark (issue 3 §9): times each paper scene of the `physical` reading and, in the
-//! same run, the independent scipy `solve_ivp(method="Radau")` solve of the same equations
-//! (`bench/radau.py`) at the same tolerance, and prints the ratio.
+//! Speed benchmark (issue 18): each paper scene of the `physical` reading against its converged
+//! reference (`tests/reference/converged.json`, tolerance 1e-10), timed (best of three) with its
+//! worst relative error, beside the independent scipy `solve_ivp(method="Radau")` solve of the
+//! same equations (`bench/radau.py`) at the same tolerance. A speed ratio is printed only where
+//! both sides hold every compared metric within 1 % of the reference (matched accuracy).
 //!
-//! `cargo run --release -p noback-twin --example bench -- [--tolerance TOL] [--no-scipy]`
+//! `cargo run --release -p noback-twin --example bench -- [--tolerance TOL] [--no-scipy] [--json]`
+use noback_twin::convergence::{self, Entry};
 use noback_twin::metrics;
 use noback_twin::reading::Reading;
 use noback_twin::scene::{Scene, SceneKind};
 use noback_twin::sim;
+use serde_json::{json, Value};
+
+/// The metrics both sides report (scipy's script reports only these).
+const COMPARED: [&str; 2] = ["braking_time_s", "braking_angle_rad"];
+
+fn worst(refs: &[Entry], scene: &str, get: &dyn Fn(&str) -> Option<f64>) -> Option<f64> {
+    let mut w: Option<f64> = None;
+    for name in COMPARED {
+        let Some(e) = refs
+            .iter()
+            .find(|e| e.scene == scene && e.reading == "physical" && e.metric == name)
+        else {
+            continue;
+        };
+        let (Some(r), Some(v)) = (e.reference, get(name)) else {
+            // A metric the reference has and the run lacks: unbounded error.
+            return Some(f64::INFINITY);
+        };
+        let err = if r == 0.0 {
+            v.abs()
+        } else {
+            ((v - r) / r).abs()
+        };
+        w = Some(w.map_or(err, |x: f64| x.max(err)));
+    }
+    w
+}
 
 fn main() {
     let args: Vec<String> = std::env::args().skip(1).collect();
@@ -17,9 +47,19 @@ fn main() {
         .and_then(|v| v.parse::<f64>().ok())
         .unwrap_or(1e-5);
     let scipy = !args.iter().any(|a| a == "--no-scipy");
-    let script = concat!(env!("CARGO_MANIFEST_DIR"), "/../bench/radau.py");
-    println!("| scene | twin wall (s) | twin RHS evals | twin braking time / angle | scipy Radau wall (s) | scipy RHS evals | scipy braking time / angle | ratio |");
-    println!("|---|---|---|---|---|---|---|---|");
+    let as_json = args.iter().any(|a| a == "--json");
+    let root = concat!(env!("CARGO_MANIFEST_DIR"), "/..");
+    let refs: Vec<Entry> =
+        std::fs::read_to_string(format!("{root}/twin/tests/reference/converged.json"))
+            .ok()
+            .and_then(|t| serde_json::from_str(&t).ok())
+            .unwrap_or_default();
+    let script = format!("{root}/bench/radau.py");
+    let mut rows: Vec<Value> = Vec::new();
+    if !as_json {
+        println!("| scene | reference braking time / angle (1e-10) | twin wall (s) | twin RHS evals | twin worst error | scipy Radau wall (s) | scipy RHS evals | scipy braking time / angle | scipy worst error | ratio at matched accuracy |");
+        println!("|---|---|---|---|---|---|---|---|---|---|");
+    }
     for kind in [
         SceneKind::ReverseLoad,
         SceneKind::ForwardLoad,
@@ -43,54 +83,80 @@ fn main() {
             }
         }
         let Some(m) = last else { continue };
-        let o = |v: Option<f64>| v.map_or("—".to_string(), |v| format!("{v:.4}"));
-        let (py_wall, py_rhs, py_bt) = if scipy {
-            let out = std::process::Command::new("timeout")
-                .arg("600")
-                .arg("python3")
-                .arg(script)
-                .arg(kind.name())
-                .arg("--tolerance")
+        let twin_err = worst(&refs, kind.name(), &|n| convergence::metric(&m, n));
+        let reference = |n: &str| {
+            refs.iter()
+                .find(|e| e.scene == kind.name() && e.reading == "physical" && e.metric == n)
+                .and_then(|e| e.reference)
+        };
+        let py: Value = if scipy {
+            eprintln!("bench: scipy Radau on {} (minutes)", kind.name());
+            match std::process::Command::new("timeout")
+                .args(["1800", "python3", &script, kind.name(), "--tolerance"])
                 .arg(format!("{tol:e}"))
-                .output();
-            match out {
-                Ok(o2) if o2.status.success() => {
-                    let v: serde_json::Value =
-                        serde_json::from_slice(&o2.stdout).unwrap_or(serde_json::Value::Null);
-                    let w = v["wall_s"].as_f64().unwrap_or(f64::NAN);
-                    let n = v["rhs_evals"].as_u64().unwrap_or(0);
-                    let bt = format!(
-                        "{} / {}",
-                        o(v["braking_time_s"].as_f64()),
-                        o(v["braking_angle_rad"].as_f64())
-                    );
-                    (w, n.to_string(), bt)
+                .output()
+            {
+                Ok(o) if o.status.success() => {
+                    serde_json::from_slice(&o.stdout).unwrap_or(Value::Null)
                 }
-                Ok(o2) => (
-                    f64::NAN,
-                    "failed".into(),
-                    String::from_utf8_lossy(&o2.stderr)
-                        .lines()
-                        .last()
-                        .unwrap_or("")
-                        .to_string(),
-                ),
-                Err(e) => (f64::NAN, "not run".into(), e.to_string()),
+                Ok(o) => {
+                    json!({"error": String::from_utf8_lossy(&o.stderr).lines().last().unwrap_or("").to_string()})
+                }
+                Err(e) => json!({"error": e.to_string()}),
             }
         } else {
-            (f64::NAN, "—".into(), "—".into())
+            Value::Null
         };
-        println!(
-            "| {} | {:.4} | {} | {} / {} | {:.2} | {} | {} | {:.0}× |",
-            kind.name(),
-            best,
-            m.rhs_evals,
-            o(m.braking_time_s),
-            o(m.braking_angle_rad),
-            py_wall,
-            py_rhs,
-            py_bt,
-            py_wall / best
-        );
+        let py_err = if py.get("wall_s").is_some() {
+            worst(&refs, kind.name(), &|n| py.get(n).and_then(Value::as_f64))
+        } else {
+            None
+        };
+        let py_wall = py.get("wall_s").and_then(Value::as_f64);
+        // Matched: a compared metric exists and both sides hold it within 1 % of the reference.
+        let matched = |e: Option<f64>| e.is_some_and(|e| e <= convergence::SETTLE);
+        let ratio = match py_wall {
+            Some(w) if matched(twin_err) && matched(py_err) => Some(w / best),
+            _ => None,
+        };
+        rows.push(json!({
+            "scene": kind.name(),
+            "tolerance": tol,
+            "reference": {"tolerance": 1e-10, "braking_time_s": reference("braking_time_s"), "braking_angle_rad": reference("braking_angle_rad")},
+            "twin": {"wall_s": best, "rhs_evals": m.rhs_evals, "braking_time_s": m.braking_time_s, "braking_angle_rad": m.braking_angle_rad, "worst_rel_error": twin_err},
+            "scipy_radau": {"run": py, "worst_rel_error": py_err},
+            "ratio_at_matched_accuracy": ratio,
+        }));
+        if !as_json {
+            let o = |v: Option<f64>| v.map_or("—".to_string(), |v| format!("{v:.4}"));
+            let pct =
+                |v: Option<f64>| v.map_or("—".to_string(), |v| format!("{:.2} %", 100.0 * v));
+            let pf = |n: &str| py.get(n).and_then(Value::as_f64);
+            println!(
+                "| {} | {} / {} | {:.4} | {} | {} | {} | {} | {} / {} | {} | {} |",
+                kind.name(),
+                o(reference("braking_time_s")),
+                o(reference("braking_angle_rad")),
+                best,
+                m.rhs_evals,
+                pct(twin_err),
+                py_wall.map_or("—".into(), |w| format!("{w:.2}")),
+                py.get("rhs_evals")
+                    .and_then(Value::as_u64)
+                    .map_or("—".into(), |n| n.to_string()),
+                o(pf("braking_time_s")),
+                o(pf("braking_angle_rad")),
+                pct(py_err),
+                match (ratio, py_wall) {
+                    (Some(r), _) => format!("{r:.0}×"),
+                    (None, Some(_)) if twin_err.is_none() => "— (no compared metric)".into(),
+                    (None, Some(_)) => "— (not matched)".into(),
+                    (None, None) => "—".into(),
+                },
+            );
+        }
+    }
+    if as_json {
+        println!("{}", json!({ "scenes": rows }));
     }
 }

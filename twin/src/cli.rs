@@ -9,7 +9,7 @@
 
 use crate::metrics::{self, Metrics};
 use crate::model::Sample;
-use crate::paper_table;
+use crate::paper_page;
 use crate::reading::Reading;
 use crate::scene::{Scene, SceneKind};
 use crate::sensing;
@@ -314,7 +314,7 @@ pub fn default_paper_doc() -> PathBuf {
 /// `cargo xtask paper`: the paper's scenes under both readings.
 #[derive(clap::Args, Debug, Clone)]
 pub struct PaperArgs {
-    /// Also print the table as one JSON object.
+    /// Print the table as one JSON object (and write nothing).
     #[arg(long)]
     pub json: bool,
     /// Where the page goes.
@@ -332,8 +332,7 @@ struct PaperCmd {
     a: PaperArgs,
 }
 
-/// `paper [--json] [--out FILE] [--tolerance TOL]` from raw arguments: run the paper's scenes
-/// under both readings and write docs/paper-comparison.md.
+/// `paper [--json] [--out FILE] [--tolerance TOL]` from raw arguments.
 pub fn paper_main(args: &[String]) -> i32 {
     match args::parse::<PaperCmd>("paper", args) {
         Ok(c) => paper_run(&c.a),
@@ -341,24 +340,26 @@ pub fn paper_main(args: &[String]) -> i32 {
     }
 }
 
-/// `paper` with parsed arguments.
+/// `paper` with parsed arguments: the paper protocol (fixed tolerances) and every figure of both
+/// readings (at TOL); writes docs/paper-comparison.md, or with `--json` prints JSON and writes
+/// nothing.
 pub fn paper_run(a: &PaperArgs) -> i32 {
     let (json, out, tolerance) = (a.json, &a.out, a.tolerance);
-    let table = match paper_table::build(tolerance) {
+    let page = match paper_page::build(tolerance) {
         Ok(t) => t,
         Err(e) => return internal("paper", &format!("paper scenes: {e}")),
     };
-    if let Err(e) = std::fs::write(out, table.markdown()) {
-        return internal("paper", &format!("cannot write {}: {e}", out.display()));
-    }
     if json {
-        match serde_json::to_string(&table) {
+        match serde_json::to_string(&page) {
             Ok(s) => println!("{s}"),
             Err(e) => return internal("paper", &format!("json: {e}")),
         }
-    } else {
-        print!("{}", table.markdown());
-        println!("\nwrote {}", out.display());
+        return 0;
     }
+    if let Err(e) = std::fs::write(out, page.markdown()) {
+        return internal("paper", &format!("cannot write {}: {e}", out.display()));
+    }
+    print!("{}", page.markdown());
+    println!("\nwrote {}", out.display());
     0
 }

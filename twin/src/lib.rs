@@ -5,12 +5,16 @@
 pub mod args;
 pub mod cli;
 pub mod contact;
+pub mod convergence;
 pub mod fault;
 pub mod friction;
 pub mod metrics;
 pub mod model;
 pub mod pack;
+pub mod paper_page;
+pub mod paper_protocol;
 pub mod paper_table;
+pub mod ramp_friction;
 pub mod reading;
 pub mod scene;
 pub mod scene_file;

@@ -55,6 +55,18 @@ pub struct Metrics {
 
 /// Compute the metrics of a run.
 pub fn compute(scene: &Scene, samples: &[Sample], stats: &SolverStats, wall_s: f64) -> Metrics {
+    compute_settled_from(scene, samples, stats, wall_s, SETTLED_FROM_S)
+}
+
+/// [`compute`] with the start of continuous closing's settled window moved to `settled_from_s`
+/// (the paper protocol's cut-time robustness check).
+pub fn compute_settled_from(
+    scene: &Scene,
+    samples: &[Sample],
+    stats: &SolverStats,
+    wall_s: f64,
+    settled_from_s: f64,
+) -> Metrics {
     let thr = scene.open.stop_threshold_rad_s;
     let release = scene.release_at_s.or(if scene.kind == SceneKind::Hold {
         Some(0.0)
@@ -63,7 +75,7 @@ pub fn compute(scene: &Scene, samples: &[Sample], stats: &SolverStats, wall_s: f
     });
     let periodic = scene.kind == SceneKind::ContinuousClosing;
     let window_start = if periodic {
-        SETTLED_FROM_S.min(scene.duration_s * 0.5)
+        settled_from_s.min(scene.duration_s * 0.5)
     } else {
         release.unwrap_or(0.0)
     };

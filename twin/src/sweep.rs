@@ -406,7 +406,16 @@ fn pressing_force(out: &std::path::Path) -> Result<(), String> {
     let spath = out.join("sweep-pressing-force.svg");
     std::fs::write(&spath, plot).map_err(|e| format!("cannot write {}: {e}", spath.display()))?;
     print!("{csv}");
-    println!("wrote {} and {}", path.display(), spath.display());
+    let fpath = out.join("sweep-pressing-force-friction.csv");
+    let fcsv = crate::ramp_friction::csv();
+    std::fs::write(&fpath, &fcsv).map_err(|e| format!("cannot write {}: {e}", fpath.display()))?;
+    print!("{fcsv}");
+    println!(
+        "wrote {}, {} and {}",
+        path.display(),
+        spath.display(),
+        fpath.display()
+    );
     Ok(())
 }
 

@@ -50,9 +50,9 @@ enum Cmd {
     Qemu(qemu::QemuArgs),
     /// Run the digital twin on one scene.
     Twin(noback_twin::cli::TwinArgs),
-    /// Twin speed against scipy Radau; writes docs/results/twin-speed.md.
+    /// Twin and scipy Radau against the converged references; writes docs/results/twin-speed.md.
     TwinBench(TwinBenchArgs),
-    /// The paper's scenes under both readings; writes docs/paper-comparison.md.
+    /// The paper protocol and both readings; writes docs/paper-comparison.md (--json: prints only).
     Paper(noback_twin::cli::PaperArgs),
     /// Design sweeps (CSV + SVG).
     Sweep(noback_twin::sweep::SweepArgs),
@@ -102,6 +102,9 @@ struct TwinBenchArgs {
     /// Measure the twin only.
     #[arg(long)]
     no_scipy: bool,
+    /// Print the comparison as one JSON object (and write nothing).
+    #[arg(long)]
+    json: bool,
 }
 
 /// A clap value parser: a core name.

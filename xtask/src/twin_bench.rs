@@ -1,8 +1,8 @@
-//! `cargo xtask twin-bench [--tolerance TOL] [--no-scipy]` — the twin's speed on each paper
-//! scene (release build) against an independent solve of the same equations with scipy's
-//! `solve_ivp(method="Radau")` (`bench/radau.py`), in the same run, at the same tolerance.
-//! Installs scipy with pip when it is missing (and says so). Writes
-//! `docs/results/twin-speed.md`.
+//! `cargo xtask twin-bench [--tolerance TOL] [--no-scipy] [--json]` — the twin's speed and
+//! worst error against its converged reference on each paper scene (release build), beside an
+//! independent solve of the same equations with scipy's `solve_ivp(method="Radau")`
+//! (`bench/radau.py`). Installs scipy with pip when it is missing (and says so). Writes
+//! `docs/results/twin-speed.md` (a benchmark page naming its machine); `--json` only prints.
 
 use crate::shell::{self, cargo, workspace_root};
 use std::process::Command;
@@ -42,10 +42,27 @@ pub fn main(args: &[String]) -> Result<i32, String> {
         eprintln!("{}", String::from_utf8_lossy(&out.stderr));
         return Err("the twin bench failed".into());
     }
+    if args.iter().any(|a| a == "--json") {
+        return Ok(0);
+    }
+    let cpu = std::fs::read_to_string("/proc/cpuinfo")
+        .ok()
+        .and_then(|c| {
+            c.lines()
+                .find(|l| l.starts_with("model name"))
+                .and_then(|l| l.split(':').nth(1))
+                .map(|m| m.trim().to_string())
+        })
+        .unwrap_or_else(|| std::env::consts::ARCH.to_string());
+    let cores = std::thread::available_parallelism().map_or(1, |n| n.get());
     let doc = format!(
-        "# Twin speed against scipy Radau\n\nWritten by `cargo xtask twin-bench {}`; do not edit. \
-         Release build, physical reading, same equations and tolerance on both sides; wall times \
-         from one run on the machine that wrote this page (a benchmark, not a test).\n\n{table}",
+        "# Twin speed against scipy Radau (benchmark page)\n\nWritten by `cargo xtask twin-bench {}`; do not edit. \
+         Release build, physical reading, same equations and tolerance on both sides. Wall times \
+         from one run on {cpu} ({cores} cores, shared): a benchmark, not a test, and they change \
+         from run to run. Errors are against the converged references \
+         (`twin/tests/reference/converged.json`, tolerance 1e-10; braking time and angle, the \
+         metrics both sides report); a speed ratio is given only where both sides hold them within 1 % (continuous closing has \
+         neither, so no ratio).\n\n{table}",
         args.join(" ")
     );
     let path = workspace_root()
