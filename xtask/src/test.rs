@@ -87,7 +87,9 @@ pub fn main(a: &TestArgs) -> Result<i32, String> {
     }
     section("host tests (library, host-tests, twin, xtask tidy)");
     shell::run(cargo().args(["test", "--workspace"]))?;
-    section("pages reproduce (reliability against its committed page, paper and monitor-mc twice)");
+    section(
+        "pages reproduce (reliability and paper against their committed pages, monitor-mc twice)",
+    );
     crate::pages::reproduce()?;
     section("Slurm: a sharded Monte Carlo as a job array, merged = unsharded");
     crate::slurm_test::stage()?;
