@@ -225,6 +225,11 @@ fn campaign_section(record: Option<&Value>, current: &Value) -> String {
     } else {
         " (not this page's monitor configuration: the bound is for the configuration recorded)"
     };
+    // A record made on an earlier monitor says so (`measured_on`): its bound is that monitor's.
+    let stale = match c["measured_on"].as_str() {
+        Some(m) => format!("{stale}; measured on {m}, to be rerun on this one"),
+        None => stale.to_string(),
+    };
     format!(
         "Seed {} (an evaluation seed: no threshold was tuned on it), plant family `{}`, monitor \
          configuration digest {}{stale}. Planned: {planned} nominal runs in {shards} shards on this \
