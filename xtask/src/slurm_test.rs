@@ -205,7 +205,7 @@ pub fn stage() -> Result<(), String> {
         dir.display()
     );
     let out = dir.join("campaign");
-    let exe = std::env::current_exe().map_err(|e| e.to_string())?;
+    let exe = crate::shell::this_exe()?; // the rebuilt binary, not a deleted path
     let submitted = cluster
         .command("bash")
         .arg(workspace_root().join("slurm/submit.sh"))
