@@ -15,13 +15,12 @@ pub const CAMPAIGN_RECORD: &str = "docs/results/mc-nominal-campaign.json";
 /// The campaign of [`CAMPAIGN_RECORD`] as planned: nominal runs, shards, seed.
 pub const CAMPAIGN_PLAN: (u64, u64, u64) = (100_000, 20, 101);
 
-/// The `--shard` values run of the plan's campaign to cover its first `runs` runs: the first
-/// four twentieths, then fortieths (two at a time finish sooner, which the session's time
-/// asked for when the machine was shared).
+/// The `--shard` values of the plan's campaign that cover its first `runs` runs.
 pub fn campaign_shards(runs: u64) -> Vec<String> {
-    let twentieths = (0..4).map(|k| format!("{k}/20"));
-    let fortieths = (8..runs * 40 / CAMPAIGN_PLAN.0).map(|k| format!("{k}/40"));
-    twentieths.chain(fortieths).collect()
+    let (planned, shards, _) = CAMPAIGN_PLAN;
+    (0..runs * shards / planned)
+        .map(|k| format!("{k}/{shards}"))
+        .collect()
 }
 
 /// The commands that made [`CAMPAIGN_RECORD`] of `runs` runs: the shards two at a time (one per
