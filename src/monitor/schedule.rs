@@ -34,11 +34,6 @@ impl Lane {
     pub const fn covered(self, n: u32) -> u32 {
         n.saturating_mul(self.ticks)
     }
-
-    /// The lane's rate (Hz) at a tick rate.
-    pub fn hz(self, tick_hz: f64) -> f64 {
-        tick_hz / f64::from(self.ticks)
-    }
 }
 
 /// The slow lane: 2.5 kHz at 10 kHz.
