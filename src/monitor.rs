@@ -216,9 +216,15 @@ impl Monitor {
             drive_drag: k.pack.drive_drag,
             min_load: k.scene.min_load,
         };
-        let (slow, slow_gave_way) =
-            st.checks
-                .slow(&k.checks, &x, &o, &st.classified, &st.load, &ci);
+        let (slow, slow_gave_way) = st.checks.slow(
+            &k.checks,
+            &x,
+            &o,
+            &st.observed,
+            &st.classified,
+            &st.load,
+            &ci,
+        );
         // Check, every tick: the braking envelope and creep.
         let dir = Dir::of(o.w, k.scene.stick_speed);
         let braking = (st.classify.scene() == Scene::FaultBraking).then(|| BrakingTick {
@@ -267,6 +273,9 @@ impl State {
         (self.classified, self.observed) = (c, *o);
         if c.just_locked {
             self.checks.locked(x);
+        }
+        if c.reading_switch {
+            self.load.reading_changed();
         }
         let moving_ok = o.settled
             && o.sensors_ok

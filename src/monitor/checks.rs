@@ -148,13 +148,15 @@ impl Checks {
         (raised, gave_way)
     }
 
-    /// The slow lane's checks on their slots (`c`: the last classification); returns the flags
-    /// raised and whether the held brake gave way.
+    /// The slow lane's checks on their slots (`c`: the last classification, `oc` the observer at
+    /// it; `o` this tick's); returns the flags raised and whether the held brake gave way.
+    #[allow(clippy::too_many_arguments)]
     pub fn slow(
         &mut self,
         k: &CheckSettings,
         x: &Sensed,
         o: &Observed,
+        oc: &Observed,
         c: &Classified,
         load: &Load,
         i: &CheckInputs,
@@ -179,15 +181,15 @@ impl Checks {
                 raised.brake_slip = gave_way;
             }
             // The running drive's checks, once it has run steadily for the observer's settling.
-            let checks_ok = o.settled
-                && o.sensors_ok
+            let checks_ok = oc.settled
+                && oc.sensors_ok
                 && !c.dir.is_none()
                 && c.scene != Scene::Holding
                 && c.phase_settled;
             if drive && checks_ok && c.steady_for_checks {
                 let t = DriveTick {
                     dir: c.dir,
-                    net: o.net,
+                    net: oc.net,
                     drive: c.along,
                     pack: if c.engaged() {
                         c.overrun_torque

@@ -131,6 +131,14 @@ impl Load {
         self.reference = self.estimate.known();
     }
 
+    /// The driving reading changed before the load was known: what was learned under the
+    /// abandoned reading is dropped and learning starts again.
+    pub fn reading_changed(&mut self) {
+        if let LoadEstimate::Learning(_) = self.estimate {
+            (self.estimate, self.learn_ticks) = (LoadEstimate::Learning(Q16::ZERO), 0);
+        }
+    }
+
     /// One slow-lane learning step with the load this call implies (`n` ticks elapsed).
     pub fn learn(&mut self, k: &LoadSettings, implied: Q16, n: u32) {
         let value = lowpass(self.estimate.value(), implied, k.alpha);
@@ -195,5 +203,36 @@ impl Load {
         c.health = self.health;
         c.available = mul_q16(self.health, c.capacity);
         c.margin = mul_q16(c.available, c.recip).min(MARGIN_MAX);
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_change_of_reading_before_the_load_is_known_restarts_learning() {
+        let k = LoadSettings::new(&Config::default()).expect("default configuration");
+        let mut load = Load::new();
+        // Learned under the overrunning reading (one call per slow-lane slot): 60 N·m, not known.
+        for _ in 0..k.known_ticks / SLOW.ticks / 2 {
+            load.learn(&k, Q16::from_num(60), 1);
+        }
+        assert!(load.estimate.known().is_none() && load.estimate.value() > Q16::from_num(10));
+        load.reading_changed();
+        assert_eq!(load.estimate, LoadEstimate::Learning(Q16::ZERO));
+        // Under the new reading the load is known after the full learning time, near −10 N·m.
+        let mut calls = 0;
+        while load.estimate.known().is_none() {
+            load.learn(&k, Q16::from_num(-10), 1);
+            calls += 1;
+        }
+        assert!(calls * SLOW.ticks >= k.known_ticks);
+        let v = load.estimate.value().to_num::<f64>();
+        assert!((-10.0..-9.0).contains(&v), "{v}");
+        assert_eq!(load.reference, Some(load.estimate.value()));
+        // A known load is kept through a change of reading.
+        load.reading_changed();
+        assert!(load.estimate.known().is_some());
     }
 }

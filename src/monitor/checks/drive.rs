@@ -15,8 +15,9 @@
 
 use crate::fx::{lowpass, Gain, Q16};
 use crate::monitor::config::{Config, ConfigError};
-use crate::monitor::convert::{filter_alpha, gain, nearest_shift, positive, q16, ticks};
+use crate::monitor::convert::{filter_alpha, gain, nearest_shift, positive, q16, scale, ticks};
 use crate::monitor::pack::{Dir, PackRatios, PackSettings};
+use crate::monitor::scale::Scale;
 use crate::monitor::schedule::SLOW;
 use crate::monitor::Flags;
 
@@ -35,6 +36,8 @@ pub(crate) struct DriveSettings {
     /// The drive torque's own step that must come with a step of the implied load: half the
     /// allowance.
     step_drive_min: Q16,
+    /// Overrunning, drive torque per N·m of implied load, halved: `1 / (2·(g₁ − 1))`.
+    step_share_overrun: Scale<30>,
     /// The drive torque's history follows by this shift (the power of two nearest `step_alpha`).
     drive_ref_shift: u32,
     /// Gain of the implied load's history, in the slow lane.
@@ -75,6 +78,10 @@ impl DriveSettings {
                 "thresholds.step_allowance_nm",
             )?,
             step_drive_min: q16(allowance / 2.0, "thresholds.step_allowance_nm")?,
+            step_share_overrun: scale(
+                0.5 / (2.0 * r.a_k / (r.a_k - 1.0) - 1.0),
+                "thresholds.step_allowance_nm",
+            )?,
             drive_ref_shift: nearest_shift(alpha),
             step_alpha: gain(alpha, "thresholds.step_reference_hz")?,
         })
@@ -202,13 +209,20 @@ impl DriveChecks {
             // reads lower. The mechanism's own torque swings — the pack engaging and
             // letting go while overrunning, tens of N·m for tens of ms with the speed held
             // within a rad/s — move the implied load through `J_s·ω̇` and leave the
-            // current alone. So the drive torque must have stepped the same way by at
-            // least half the allowance (a pure current step moves the implied load by the
-            // full step, or `g₁ − 1` times it while overrunning).
+            // current alone. So the drive torque must have stepped the same way by half the
+            // allowance and by half the implied load's step (a current step moves the implied
+            // load by the full step, at most `g₁ − 1` times it with the ramps engaged).
+            let dev_abs = dev.saturating_abs().to_bits();
+            let share = Q16::from_bits(if t.engaged {
+                p.step_share_overrun.apply(dev_abs)
+            } else {
+                dev_abs >> 1
+            });
+            let needed = share.max(p.step_drive_min);
             let drive_step = t.drive.saturating_sub(self.drive_ref);
             let (harder, lighter) = (
-                harder && drive_step > p.step_drive_min,
-                lighter && drive_step < p.step_drive_min.saturating_neg(),
+                harder && drive_step > needed,
+                lighter && drive_step < needed.saturating_neg(),
             );
             // The harder half waits out a pending change towards overrunning (the light-load
             // chatter of continuous closing pulses the drive torque by 9 N·m and makes the
@@ -379,6 +393,34 @@ mod tests {
         c.reset(); // `reset_flags`
         run(&mut c, &carrying(15.0, false), 100);
         assert!(run(&mut c, &carrying(22.0, false), 40).brake_drag);
+    }
+
+    #[test]
+    fn an_implied_load_step_the_drive_torque_explains_less_than_half_of_is_no_fault() {
+        // Overrunning: the implied load falls by 11 N·m (the pack engaging and letting go moves
+        // it through `J_s·ω̇`) while the drive torque falls by 0.9 N·m, more than half the
+        // allowance but less than half of what a current step would need: no verdict.
+        let before = overrunning(2.45, false);
+        let mut after = overrunning(1.55, false);
+        after.net = before.net.saturating_sub(Q16::from_num(11.0));
+        after.pack = before.pack;
+        let mut c = DriveChecks::default();
+        run(&mut c, &before, 100);
+        assert_eq!(run(&mut c, &after, 40), Flags::default());
+        // The same fall with the drive torque falling by the share a lost gain gives: counted.
+        let share = 11.0 / (2.0 * r_g1_minus_1());
+        let mut lost = overrunning(2.45 - 1.1 * share, false);
+        lost.net = after.net;
+        lost.pack = before.pack;
+        let mut c = DriveChecks::default();
+        run(&mut c, &before, 100);
+        assert!(run(&mut c, &lost, 26).sensor_fault);
+    }
+
+    /// `g₁ − 1`, the implied load's step per N·m of drive torque while overrunning.
+    fn r_g1_minus_1() -> f64 {
+        let p = params();
+        p.step_limit_overrun.to_num::<f64>() / p.step_limit.to_num::<f64>()
     }
 
     #[test]
