@@ -15,8 +15,9 @@
 //! ```
 //!
 //! # Stages
-//! [`Monitor::step`] runs them in data order; each is a settings type, built once from
-//! [`Config`] by a builder beside it, and a state type.
+//! [`Monitor::tick`] (the 10 kHz interrupt) and [`Monitor::background`] (the slow lane, at a
+//! lower priority before the next tick) run them in data order; [`Monitor::step`] is both. Each
+//! stage is a settings type, built once from [`Config`] by a builder beside it, and a state type.
 //!
 //! | stage | module | in | out |
 //! |---|---|---|---|
@@ -116,6 +117,10 @@ struct State {
     energy: Energy,
     checks: Checks,
     flags: Flags,
+    /// The last tick's slow-lane work, until [`Monitor::background`] runs it.
+    job: Option<Job>,
+    /// The last slow-lane run's results, until the next tick applies them.
+    slow: SlowResult,
 }
 
 /// The monitor: settings apart from state. One [`Monitor::step`] per tick.
@@ -152,6 +157,8 @@ impl Monitor {
                 energy: Energy::new(),
                 checks: Checks::new(),
                 flags: Flags::default(),
+                job: None,
+                slow: SlowResult::NONE,
             },
         };
         monitor.state.refresh_load(&monitor.settings);
@@ -182,24 +189,92 @@ impl Monitor {
         self.state.checks.reset(counters);
     }
 
-    /// One tick: reads the raw inputs, advances the model, returns the estimate. Never panics;
-    /// every output is bounded by its format.
+    /// One tick on the host: [`Monitor::tick`] then [`Monitor::background`], as the target runs
+    /// them when the background work finishes before the next tick. Never panics; every output
+    /// is bounded by its format.
     pub fn step(&mut self, inputs: &Inputs) -> Estimate {
+        let estimate = self.tick(inputs);
+        self.background();
+        estimate
+    }
+
+    /// The 10 kHz interrupt's part: sense, observe, the per-tick checks and the observer's
+    /// feed-forward; latches the flags and reports. The slow lane's results it uses are those
+    /// of the previous [`Monitor::background`].
+    pub fn tick(&mut self, inputs: &Inputs) -> Estimate {
         let (k, st) = (&self.settings, &mut self.state);
         // Schedule.
         let n = u32::from(inputs.ticks_elapsed.max(1));
         st.tick = st.tick.wrapping_add(n); // modular on purpose
         let slot = Slot::of(st.tick);
-        // Sense and observe, every tick.
+        // Sense and observe.
         let carrying = st.classify.scene() == Scene::Driving;
         let x = st.sense.read(&k.sense, inputs, n, carrying);
         let o = st.observe.update(&k.observe, &x);
+        if x.first {
+            // Until the first classification (the next background): the pack at rest as the
+            // drive command leaves it, untrusted.
+            let e = &mut st.estimate;
+            (e.scene, e.brake, e.pressing_force_n) = if x.drive {
+                (Scene::Driving, BrakeState::Released, k.pack.drive_force)
+            } else {
+                (
+                    Scene::FaultBraking,
+                    BrakeState::Slipping,
+                    k.pack.spring_force,
+                )
+            };
+        }
         st.classify.tick(&x, &o);
         st.checks.events(&k.checks, &x, &o);
         if x.drive_edge && x.drive {
             st.load.drive_started();
         }
-        // The slow lane's part of this tick: classify and estimate, energy, checks, window.
+        // Check: the braking envelope and creep.
+        let dir = Dir::of(o.w, k.scene.stick_speed);
+        let braking = (st.classify.scene() == Scene::FaultBraking).then(|| BrakingTick {
+            n,
+            tick: st.tick,
+            d_out: x.d_out,
+            dir,
+            load_dir: Dir::of(st.load.estimate.value(), k.scene.min_load),
+            load_abs: st.load.estimate.value().saturating_abs(),
+            capacity: st.load.cache.capacity,
+        });
+        let (fast, gave_way) = st.checks.every_tick(&k.checks, &x, &o, braking);
+        if gave_way || st.slow.gave_way {
+            st.classify.lose_hold();
+        }
+        // The pack torque the observer's model feeds forward into the next prediction.
+        let model = estimate::model_torque(
+            &k.pack,
+            x.drive,
+            st.classify.locked(),
+            st.classify.overrunning(),
+            dir,
+            st.observe.disturbance().saturating_add(o.drive_torque),
+            o.drive_torque,
+            st.load.cache.capacity,
+        );
+        st.observe.set_model_torque(model, st.slow.reading_switch);
+        // Flag: the one place flags are latched.
+        let mut raised = st.slow.raised.union(fast);
+        raised.sensor_fault |= o.fault;
+        raised.overrun |= n > 1;
+        st.flags = st.flags.union(raised);
+        st.slow = SlowResult::NONE;
+        st.job = Some(Job { slot, x, o });
+        st.report(&o)
+    }
+
+    /// The slow lane's work for the last [`Monitor::tick`] (one slot of classify, estimate,
+    /// checks, window), run at a lower priority before the next tick; its results reach the
+    /// next tick. Does nothing when called twice.
+    pub fn background(&mut self) {
+        let (k, st) = (&self.settings, &mut self.state);
+        let Some(Job { slot, x, o }) = st.job.take() else {
+            return;
+        };
         let mut reading_switch = false;
         match slot {
             _ if x.first => {
@@ -216,7 +291,7 @@ impl Monitor {
             drive_drag: k.pack.drive_drag,
             min_load: k.scene.min_load,
         };
-        let (slow, slow_gave_way) = st.checks.slow(
+        let (raised, gave_way) = st.checks.slow(
             &k.checks,
             &x,
             &o,
@@ -225,40 +300,38 @@ impl Monitor {
             &st.load,
             &ci,
         );
-        // Check, every tick: the braking envelope and creep.
-        let dir = Dir::of(o.w, k.scene.stick_speed);
-        let braking = (st.classify.scene() == Scene::FaultBraking).then(|| BrakingTick {
-            n,
-            tick: st.tick,
-            d_out: x.d_out,
-            dir,
-            load_dir: Dir::of(st.load.estimate.value(), k.scene.min_load),
-            load_abs: st.load.estimate.value().saturating_abs(),
-            capacity: st.load.cache.capacity,
-        });
-        let (fast, fast_gave_way) = st.checks.every_tick(&k.checks, &x, &o, braking);
-        if slow_gave_way || fast_gave_way {
-            st.classify.lose_hold();
-        }
-        // The pack torque the observer's model feeds forward into the next prediction.
-        let model = estimate::model_torque(
-            &k.pack,
-            x.drive,
-            st.classify.locked(),
-            st.classify.overrunning(),
-            dir,
-            st.observe.disturbance().saturating_add(o.drive_torque),
-            o.drive_torque,
-            st.load.cache.capacity,
-        );
-        st.observe.set_model_torque(model, reading_switch);
-        // Flag: the one place flags are latched.
-        let mut raised = slow.union(fast);
-        raised.sensor_fault |= o.fault;
-        raised.overrun |= n > 1;
-        st.flags = st.flags.union(raised);
-        st.report(&o)
+        st.slow = SlowResult {
+            raised,
+            gave_way,
+            reading_switch,
+        };
     }
+}
+
+/// A tick's slow-lane work: its slot and what sensing and the observer handed on.
+#[derive(Clone, Copy, Debug)]
+struct Job {
+    slot: Slot,
+    x: Sensed,
+    o: Observed,
+}
+
+/// What the slow lane hands the next tick.
+#[derive(Clone, Copy, Debug)]
+struct SlowResult {
+    raised: Flags,
+    /// The held brake gave way (a slip check).
+    gave_way: bool,
+    /// The driving reading changed (bumpless for the observer).
+    reading_switch: bool,
+}
+
+impl SlowResult {
+    const NONE: SlowResult = SlowResult {
+        raised: Flags::from_bits(0),
+        gave_way: false,
+        reading_switch: false,
+    };
 }
 
 impl State {

@@ -585,8 +585,8 @@ mod envelope {
 
     /// Ticks the plant's output must have stood still before a holding estimate reports exactly
     /// the load: the impact estimate looks back 2 × 16 ticks from the slow lane's last
-    /// classification, which may be `SLOW.ticks − 1` ticks old.
-    const QUIET_TICKS: u32 = 33 + noback::monitor::schedule::SLOW.ticks - 1;
+    /// classification, which reaches the report up to `SLOW.ticks` ticks later.
+    const QUIET_TICKS: u32 = 33 + noback::monitor::schedule::SLOW.ticks;
 
     /// For each estimate of a trace, the loads of the last 16 estimates with the drive on (the
     /// ones the monitor's load cache may hold).

@@ -1,8 +1,8 @@
 //! The panic-never proof of the real-time path, checked by the linker rather than by reading.
 //!
-//! This image calls `Monitor::new`, `Monitor::step` and the firmware's `Ticker::tick` on inputs
-//! the optimiser cannot see (`black_box`), and its panic handler calls a function that does not
-//! exist. If any panic path (an `unwrap`, an index, an overflow check, a division by a possible
+//! This image calls `Monitor::new`, `Monitor::step` and the firmware's `Ticker::tick` and
+//! `Ticker::background` on inputs the optimiser cannot see (`black_box`), and its panic
+//! handler calls a function that does not exist. If any panic path (an `unwrap`, an index, an overflow check, a division by a possible
 //! zero) survives optimisation anywhere in those calls, the release build fails to link with an
 //! undefined symbol naming the problem. `cargo xtask test` builds it for the M0 and the M3.
 #![cfg_attr(target_os = "none", no_std, no_main)]
@@ -57,6 +57,7 @@ mod target {
         let mut ticker = Ticker::new(monitor, Opaque, Pin);
         loop {
             black_box(ticker.tick(black_box(1)));
+            ticker.background();
             black_box(ticker.next_event());
             if black_box(false) {
                 ticker.reset_flags();

@@ -5,15 +5,16 @@
 //! All target-only code of the product is in this file and `noback::platform`; the work of a
 //! tick is the portable `noback::app::Ticker`, which the host tests run too. Two modes, chosen
 //! by the semihosting argument QEMU passes:
-//! - `realtime` (default): SysTick interrupts at 10 kHz; each interrupt steps the monitor on
-//!   the next sample and drives the alarm pin; the main loop refills the sample ring from the
-//!   file and drains the log ring buffer to defmt, so neither reading nor logging blocks the
-//!   interrupt. `overrun-at=N` burns time in tick N to
+//! - `realtime` (default): SysTick interrupts at 10 kHz; each interrupt runs the monitor's
+//!   10 kHz part on the next sample, drives the alarm pin and pends PendSV, which runs the
+//!   monitor's slow-lane work at the lowest priority before the next tick; the main loop
+//!   refills the sample ring from the file and drains the log ring buffer to defmt, so neither
+//!   reading nor logging blocks the interrupt. `overrun-at=N` burns time in tick N to
 //!   provoke a missed deadline, which must be counted and flagged; `reset-every=N` has the
 //!   operator reset the flags after every N-th tick (the load test: flags keep changing).
-//! - `bench`: the same monitor steps back to back without interrupts, each `Monitor::step`
-//!   measured alone with SysTick (the file reads stay outside the measured span), for
-//!   deterministic instruction counts under QEMU `-icount`.
+//! - `bench`: the same monitor steps back to back without interrupts, each `Monitor::tick` and
+//!   `Monitor::background` measured alone with SysTick (the file reads stay outside the
+//!   measured span), for deterministic instruction counts under QEMU `-icount`.
 //!
 //! Both end with a `summary` line carrying the digest of every estimate, which the xtask
 //! compares with the host's run on the same trace.
@@ -21,11 +22,11 @@
 
 #[cfg(target_os = "none")]
 mod target {
-    use core::cell::RefCell;
+    use core::cell::UnsafeCell;
     use core::sync::atomic::{AtomicBool, AtomicU32, AtomicU8, Ordering};
+    use cortex_m::peripheral::scb::SystemHandler;
     use cortex_m::peripheral::{syst::SystClkSource, SCB, SYST};
     use cortex_m_rt::{entry, exception};
-    use critical_section::Mutex;
     use noback::app::Ticker;
     use noback::board::SampleSource;
     use noback::digest::Fnv1a;
@@ -50,7 +51,26 @@ mod target {
     const TICK_HZ: u32 = 10_000;
 
     type App = Ticker<Streamed<'static>, AlarmPin>;
-    static APP: Mutex<RefCell<Option<App>>> = Mutex::new(RefCell::new(None));
+
+    /// The application, shared by three contexts without a lock: SysTick touches it only while
+    /// [`BACKGROUND_DUE`] is clear, PendSV (lowest priority) only while it is set, and the main
+    /// loop only inside a critical section (thread mode never runs inside a handler).
+    struct Shared(UnsafeCell<Option<App>>);
+    // SAFETY: the access protocol above gives one context at a time on this single core.
+    #[allow(unsafe_code)]
+    unsafe impl Sync for Shared {}
+    static APP: Shared = Shared(UnsafeCell::new(None));
+    /// Set by SysTick when it pends the background work, cleared by PendSV when it is done.
+    static BACKGROUND_DUE: AtomicBool = AtomicBool::new(false);
+    /// Most SysTick ticks from a tick's start to the end of its background work.
+    static BACKGROUND_TICKS_MAX: AtomicU32 = AtomicU32::new(0);
+
+    /// The application. SAFETY: the caller holds its turn under [`Shared`]'s protocol.
+    #[allow(unsafe_code)]
+    unsafe fn shared_app() -> Option<&'static mut App> {
+        // SAFETY: one context at a time (the protocol), so this is the only reference.
+        unsafe { (*APP.0.get()).as_mut() }
+    }
     /// Ticks elapsed to report on the next interrupt (2 after a missed deadline).
     static ELAPSED: AtomicU8 = AtomicU8::new(1);
     static DONE: AtomicBool = AtomicBool::new(false);
@@ -145,7 +165,7 @@ mod target {
             run_bench(replay, feeder, file, monitor, peripherals.SYST)
         } else {
             let app = Ticker::new(monitor, replay, AlarmPin { high: false });
-            run_realtime(app, feeder, file, peripherals.SYST)
+            run_realtime(app, feeder, file, peripherals.SYST, peripherals.SCB)
         }
     }
 
@@ -172,9 +192,9 @@ mod target {
         }
     }
 
-    /// Steps the monitor back to back on the replay, measuring each `Monitor::step` alone (the
-    /// digest and the logging stay outside the measured span). The digest equals the real-time
-    /// run's: both fold every estimate's words in order.
+    /// Steps the monitor back to back on the replay, measuring each `Monitor::tick` and each
+    /// `Monitor::background` alone (the digest and the logging stay outside the measured
+    /// spans). The digest equals the real-time run's: both fold every estimate's words in order.
     fn run_bench(
         mut replay: Streamed<'static>,
         mut feeder: Feeder<'static>,
@@ -186,6 +206,7 @@ mod target {
         let (a, b) = (meter.now(), meter.now());
         let overhead = Meter::ticks(a, b);
         let (mut sum, mut max, mut steps) = (0_u64, 0_u32, 0_u32);
+        let (mut bg_sum, mut bg_max) = (0_u64, 0_u32);
         // Worst step per recognised scene (Scene as u8: Driving, Holding, FaultBraking,
         // Overrunning): what each scene's model costs.
         let mut scene_max = [0_u32; 4];
@@ -197,10 +218,15 @@ mod target {
                 break;
             };
             let start = meter.now();
-            let estimate = monitor.step(&inputs);
+            let estimate = monitor.tick(&inputs);
             let ticks = Meter::ticks(start, meter.now()).saturating_sub(overhead);
             sum += u64::from(ticks);
             max = max.max(ticks);
+            let start = meter.now();
+            monitor.background();
+            let bg = Meter::ticks(start, meter.now()).saturating_sub(overhead);
+            bg_sum += u64::from(bg);
+            bg_max = bg_max.max(bg);
             let scene = usize::from(estimate.scene as u8);
             if let (Some(m), Some(at)) = (scene_max.get_mut(scene), scene_max_at.get_mut(scene)) {
                 if ticks > *m {
@@ -212,10 +238,12 @@ mod target {
             digest.push(noback::app::estimate_checksum(&estimate));
         }
         defmt::info!(
-            "bench steps={=u32} ticks_sum={=u64} ticks_max={=u32} overhead={=u32} stack_bytes={=u32} starved={=u32} digest={=u32:#010x}",
+            "bench steps={=u32} ticks_sum={=u64} ticks_max={=u32} bg_ticks_sum={=u64} bg_ticks_max={=u32} overhead={=u32} stack_bytes={=u32} starved={=u32} digest={=u32:#010x}",
             steps,
             sum,
             max,
+            bg_sum,
+            bg_max,
             overhead,
             stack::high_water_bytes(),
             replay.starved(),
@@ -236,8 +264,19 @@ mod target {
     }
 
     /// SysTick at 10 kHz drives the ticks; the main loop refills the sample ring and logs.
-    fn run_realtime(app: App, mut feeder: Feeder<'static>, mut file: File, mut syst: SYST) -> ! {
-        critical_section::with(|cs| APP.borrow(cs).replace(Some(app)));
+    #[allow(unsafe_code)] // the shared application (`Shared`) and PendSV's priority
+    fn run_realtime(
+        app: App,
+        mut feeder: Feeder<'static>,
+        mut file: File,
+        mut syst: SYST,
+        mut scb: SCB,
+    ) -> ! {
+        // SAFETY: no interrupt is enabled yet: this is the only context.
+        unsafe { *APP.0.get() = Some(app) };
+        // SAFETY: PendSV at the lowest priority, so SysTick (priority 0) preempts it; no
+        // priority-based critical section relies on these levels.
+        unsafe { scb.set_priority(SystemHandler::PendSV, 0xFF) };
         syst.set_clock_source(SystClkSource::Core);
         syst.set_reload(CLOCK_HZ / TICK_HZ - 1);
         syst.clear_current();
@@ -245,12 +284,9 @@ mod target {
         syst.enable_counter();
         loop {
             let fed = feed(&mut feeder, &mut file);
-            let event = critical_section::with(|cs| {
-                APP.borrow(cs)
-                    .borrow_mut()
-                    .as_mut()
-                    .and_then(Ticker::next_event)
-            });
+            // SAFETY: inside a critical section neither handler runs.
+            let event =
+                critical_section::with(|_| unsafe { shared_app() }.and_then(Ticker::next_event));
             match event {
                 Some(event) => log(&event),
                 None if DONE.load(Ordering::Acquire) => break,
@@ -262,11 +298,13 @@ mod target {
         syst.disable_counter();
         // The summary reads the state where it lives: taking it out would copy the whole
         // application (monitor, replay cursor, event log) onto the stack.
-        critical_section::with(|cs| {
-            if let Some(app) = APP.borrow(cs).borrow().as_ref() {
-                finish(app)
-            }
-        });
+        // SAFETY: both interrupts are off for good (the background's last pend may run first).
+        while BACKGROUND_DUE.load(Ordering::Acquire) {
+            core::hint::spin_loop();
+        }
+        if let Some(app) = unsafe { shared_app() } {
+            finish(app)
+        }
         fail("the application state vanished")
     }
 
@@ -274,7 +312,7 @@ mod target {
         let t = app.totals();
         let last = app.last_estimate();
         defmt::info!(
-            "summary ticks={=u32} overruns={=u32} missed={=u32} starved={=u32} log_overwritten={=u32} alarm_errors={=u32} flags={=u8:#04x} stack_bytes={=u32} isr_ticks_max={=u32} period_ticks={=u32} digest={=u32:#010x}",
+            "summary ticks={=u32} overruns={=u32} missed={=u32} starved={=u32} log_overwritten={=u32} alarm_errors={=u32} flags={=u8:#04x} stack_bytes={=u32} isr_ticks_max={=u32} background_ticks_max={=u32} period_ticks={=u32} digest={=u32:#010x}",
             t.ticks,
             t.overruns,
             t.missed_ticks,
@@ -284,6 +322,7 @@ mod target {
             last.map_or(0, |e| e.flags.bits()),
             stack::high_water_bytes(),
             ISR_TICKS_MAX.load(Ordering::Relaxed),
+            BACKGROUND_TICKS_MAX.load(Ordering::Relaxed),
             CLOCK_HZ / TICK_HZ,
             t.digest
         );
@@ -355,25 +394,32 @@ mod target {
     }
 
     #[exception]
+    #[allow(unsafe_code)] // the shared application (`Shared`)
     fn SysTick() {
         // Load and store, not swap: thumbv6m has no atomic read-modify-write, and only this
         // handler (which cannot preempt itself) writes ELAPSED.
         let n = ELAPSED.load(Ordering::Relaxed);
+        if BACKGROUND_DUE.load(Ordering::Acquire) {
+            // The last tick's background work is still running: this tick is missed.
+            ELAPSED.store(n.saturating_add(1), Ordering::Relaxed);
+            return;
+        }
         ELAPSED.store(1, Ordering::Relaxed);
         let tick_no = TICK_NO.load(Ordering::Relaxed);
         TICK_NO.store(tick_no.wrapping_add(1), Ordering::Relaxed);
         let reset_every = RESET_EVERY.load(Ordering::Relaxed);
-        let stepped = critical_section::with(|cs| {
-            let mut app = APP.borrow(cs).borrow_mut();
-            let app = app.as_mut()?;
+        // SAFETY: BACKGROUND_DUE is clear, so PendSV is not using the application.
+        let stepped = unsafe { shared_app() }.is_some_and(|app| {
             let estimate = app.tick(n);
             if reset_every != 0 && tick_no.wrapping_add(1).is_multiple_of(reset_every) {
                 app.reset_flags();
             }
-            estimate
-        })
-        .is_some();
-        if !stepped {
+            estimate.is_some()
+        });
+        if stepped {
+            BACKGROUND_DUE.store(true, Ordering::Release);
+            SCB::set_pendsv();
+        } else {
             DONE.store(true, Ordering::Release);
         }
         if tick_no == OVERRUN_AT.load(Ordering::Relaxed) {
@@ -385,12 +431,33 @@ mod target {
         if SCB::is_pendst_pending() {
             ELAPSED.store(2, Ordering::Relaxed);
         } else {
-            // Time used of this period, entry latency included: SysTick counts down from the
-            // reload value, which it reloaded when this tick began.
-            let used = (CLOCK_HZ / TICK_HZ - 1).saturating_sub(SYST::get_current());
-            if used > ISR_TICKS_MAX.load(Ordering::Relaxed) {
-                ISR_TICKS_MAX.store(used, Ordering::Relaxed);
-            }
+            record_max(&ISR_TICKS_MAX);
+        }
+    }
+
+    /// The monitor's slow-lane work for the last tick, at the lowest priority.
+    #[exception]
+    #[allow(unsafe_code)] // the shared application (`Shared`)
+    fn PendSV() {
+        if !BACKGROUND_DUE.load(Ordering::Acquire) {
+            return;
+        }
+        // SAFETY: BACKGROUND_DUE is set, so SysTick leaves the application alone.
+        if let Some(app) = unsafe { shared_app() } {
+            app.background();
+        }
+        if !SCB::is_pendst_pending() {
+            record_max(&BACKGROUND_TICKS_MAX);
+        }
+        BACKGROUND_DUE.store(false, Ordering::Release);
+    }
+
+    /// Raises `max` to the time used of this period, entry latency included: SysTick counts
+    /// down from the reload value, which it reloaded when this tick began.
+    fn record_max(max: &AtomicU32) {
+        let used = (CLOCK_HZ / TICK_HZ - 1).saturating_sub(SYST::get_current());
+        if used > max.load(Ordering::Relaxed) {
+            max.store(used, Ordering::Relaxed);
         }
     }
 }

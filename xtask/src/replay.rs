@@ -108,6 +108,8 @@ pub fn host_run(
         if reset_every.is_some_and(|every| every > 0 && (stepped + 1) % every == 0) {
             ticker.reset_flags();
         }
+        // The firmware's lower-priority context, before the next tick.
+        ticker.background();
         while ticker.next_event().is_some() {}
     }
     Ok(HostRun {

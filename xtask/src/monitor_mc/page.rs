@@ -229,8 +229,11 @@ fn campaign_section(record: Option<&Value>, current: &Value) -> String {
         Some(m) => format!("{stale}; measured on {m}, to be rerun on this one"),
         None => stale.to_string(),
     };
+    let seed_note = c["seed_note"]
+        .as_str()
+        .unwrap_or("an evaluation seed: no threshold was tuned on it");
     format!(
-        "Seed {} (an evaluation seed: no threshold was tuned on it), plant family `{}`, monitor \
+        "Seed {} ({seed_note}), plant family `{}`, monitor \
          configuration digest {}{stale}. Planned: {planned} nominal runs in {shards} shards on this \
          machine; {done}:\n\n```sh\n{}\n```\n\n{}\n",
         c["seed"],
