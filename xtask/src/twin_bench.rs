@@ -27,6 +27,8 @@ pub fn main(args: &[String]) -> Result<i32, String> {
         "--release",
         "-p",
         "noback-twin",
+        "--features",
+        "peer",
         "--example",
         "bench",
         "--",
