@@ -5,7 +5,7 @@
 //! `OdeSystem`, same event rule) at the same tolerance. A speed ratio is printed only where both
 //! sides hold every compared metric within 1 % of the reference (matched accuracy).
 //!
-//! `cargo run --release -p noback-twin --features peer --example bench -- [--tolerance TOL] [--no-scipy] [--json]`
+//! `cargo run --release -p noback-twin --features peer --example bench -- [--tolerance TOL] [--no-scipy] [--json | --json-out PATH]`
 use noback_twin::convergence::{self, Entry};
 use noback_twin::metrics;
 use noback_twin::reading::Reading;
@@ -189,5 +189,14 @@ fn main() {
     }
     if as_json {
         println!("{}", json!({ "scenes": rows }));
+    } else if let Some(p) = args
+        .iter()
+        .position(|a| a == "--json-out")
+        .and_then(|i| args.get(i + 1))
+    {
+        if let Err(e) = std::fs::write(p, json!({ "scenes": rows }).to_string()) {
+            eprintln!("{p}: {e}");
+            std::process::exit(2);
+        }
     }
 }
