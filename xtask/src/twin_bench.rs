@@ -110,7 +110,7 @@ pub fn main(args: &[String]) -> Result<i32, String> {
         .unwrap_or_else(|| std::env::consts::ARCH.to_string());
     let cores = std::thread::available_parallelism().map_or(1, |n| n.get());
     let doc = format!(
-        "# Twin speed against scipy Radau (benchmark page)\n\nWritten by `cargo xtask twin-bench {}`; do not edit. \
+        "# Twin speed against diffsol and scipy Radau (benchmark page)\n\nWritten by `cargo xtask twin-bench{}`; do not edit. \
          Release build, physical reading, same equations and tolerance on both sides. Wall times \
          from one run on {cpu} ({cores} cores, shared): a benchmark, not a test, and they change \
          from run to run. Errors are against the converged references \
@@ -124,7 +124,7 @@ pub fn main(args: &[String]) -> Result<i32, String> {
          (scipy: braking time and angle only, one tolerance). A solver meets an accuracy level at \
          its cheapest tolerance whose worst error is at or below it at that and every tighter tolerance; the ratio compares those \
          cheapest walls. Chart: `work-precision.svg`.\n\n![work-precision](work-precision.svg)\n\n{wp_md}",
-        args.join(" ")
+        args.iter().map(|a| format!(" {a}")).collect::<String>()
     );
     let path = workspace_root()
         .join("docs")

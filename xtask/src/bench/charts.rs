@@ -3,7 +3,7 @@
 //! point) and the stability map. Axes in engineering notation; point labels only as numbers
 //! that are drawn where they do not collide, with the full names in a key beside the panels.
 
-use super::work_precision::eng;
+use super::work_precision::{decades, eng, eng_unit};
 use plotters::coord::Shift;
 use plotters::prelude::*;
 use std::path::Path;
@@ -103,14 +103,17 @@ fn draw_panel(
         y0 = y0.min(*y);
         y1 = y1.max(*y);
     }
-    y0 = y0.min(panel.monitor_err).max(1e-9) * 0.5;
-    y1 = y1.max(panel.monitor_err) * 2.0;
+    let (y0, y1) = decades(
+        y0.min(panel.monitor_err).max(1e-9),
+        y1.max(panel.monitor_err),
+    );
+    let (x0, x1) = decades(x0, x1);
     let mut c = ChartBuilder::on(area)
         .caption(panel.title, ("sans-serif", 14))
         .margin(10)
         .x_label_area_size(40)
         .y_label_area_size(64)
-        .build_cartesian_2d((x0 * 0.7..x1 * 1.4).log_scale(), (y0..y1).log_scale())
+        .build_cartesian_2d((x0..x1).log_scale(), (y0..y1).log_scale())
         .map_err(err)?;
     c.configure_mesh()
         .x_desc("M3 instructions per simulated second (QEMU -icount)")
@@ -152,10 +155,10 @@ fn draw_panel(
     let mut placed: Vec<(i32, i32)> = vec![c.backend_coord(&(monitor_per_s, panel.monitor_err))];
     for (n, (x, y, label)) in line.iter().enumerate() {
         key.push(format!(
-            "{:>2}  {label}: {}/s, {} N·m",
+            "{:>2}  {label}: {}, {}",
             n + 1,
-            eng(*x),
-            eng(*y)
+            eng_unit(*x, "/s"),
+            eng_unit(*y, "N·m")
         ));
         let (px, py) = c.backend_coord(&(*x, *y));
         if placed

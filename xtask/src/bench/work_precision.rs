@@ -51,6 +51,26 @@ pub fn eng(v: f64) -> String {
     format!("{s}{}{prefix}", if prefix.is_empty() { "" } else { " " })
 }
 
+/// `v` with a unit in engineering notation (`715 mN·m`, `2.57 N·m`).
+pub fn eng_unit(v: f64, unit: &str) -> String {
+    let e = eng(v);
+    if e.contains(' ') {
+        format!("{e}{unit}")
+    } else {
+        format!("{e} {unit}")
+    }
+}
+
+/// The log-axis range spanning whole decades around `[lo, hi]`, at least one decade wide.
+pub fn decades(lo: f64, hi: f64) -> (f64, f64) {
+    let a = 10f64.powf(lo.max(1e-300).log10().floor());
+    let mut b = 10f64.powf(hi.max(1e-300).log10().ceil());
+    if b <= a {
+        b = a * 10.0;
+    }
+    (a, b)
+}
+
 /// One measured point.
 #[derive(Clone, Debug)]
 pub struct Point {
@@ -212,8 +232,14 @@ pub fn chart(path: &Path, pts: &[Point]) -> Result<(), String> {
             .x_label_area_size(36)
             .y_label_area_size(60)
             .build_cartesian_2d(
-                (x0 * 0.7..x1 * 1.4).log_scale(),
-                (y0 * 0.5..y1 * 3.0).log_scale(),
+                {
+                    let (a, b) = decades(x0, x1);
+                    (a..b).log_scale()
+                },
+                {
+                    let (a, b) = decades(y0, y1);
+                    (a..b).log_scale()
+                },
             )
             .map_err(e)?;
         c.configure_mesh()
@@ -267,6 +293,10 @@ mod tests {
         assert_eq!(eng(150_000.0), "150 k");
         assert_eq!(eng(0.5), "500 m");
         assert_eq!(eng(3.0), "3");
+        assert_eq!(eng_unit(0.715, "N·m"), "715 mN·m");
+        assert_eq!(eng_unit(2.57, "N·m"), "2.57 N·m");
+        assert_eq!(decades(16.9, 91.0), (10.0, 100.0));
+        assert_eq!(decades(20.0, 30.0), (10.0, 100.0));
     }
 
     #[test]
