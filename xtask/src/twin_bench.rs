@@ -1,4 +1,4 @@
-//! `cargo xtask twin-bench [--tolerance TOL] [--no-scipy] [--json]` — the twin's speed and
+//! `cargo xtask twin-bench [--tolerance TOL] [--no-scipy] [--scipy-tolerances A,B] [--json]` — the twin's speed and
 //! worst error against its converged reference on each paper scene (release build), beside the
 //! compiled diffsol peer (same `OdeSystem`, `--features peer`) and an independent solve of the
 //! same equations with scipy's `solve_ivp(method="Radau")` (`bench/radau.py`; installed with pip
@@ -85,6 +85,22 @@ pub fn main(args: &[String]) -> Result<i32, String> {
     let mut pts = wp::parse(&String::from_utf8_lossy(&wout.stdout));
     let bench: serde_json::Value = serde_json::from_str(&bench_json).unwrap_or_default();
     pts.extend(scipy_points(&bench));
+    if scipy {
+        let list = args
+            .iter()
+            .position(|a| a == "--scipy-tolerances")
+            .and_then(|i| args.get(i + 1))
+            .map_or("1e-3,1e-4", String::as_str);
+        let mut tols = Vec::new();
+        for t in list.split(',') {
+            tols.push(
+                t.trim()
+                    .parse::<f64>()
+                    .map_err(|_| format!("--scipy-tolerances: `{t}` is not a number"))?,
+            );
+        }
+        pts.extend(scipy_sweep(&bench, &tols)?);
+    }
     if json {
         let mut v = bench;
         let list: Vec<serde_json::Value> = pts
@@ -121,7 +137,7 @@ pub fn main(args: &[String]) -> Result<i32, String> {
          takes every metric.\n\n{table}\n## Work–precision\n\n\
          `examples/work_precision.rs`: tolerances 1e-3 … 1e-7, best of three runs each; error = \
          worst relative error over every metric of the scene that has a converged reference \
-         (scipy: braking time and angle only, one tolerance). A solver meets an accuracy level at \
+         (scipy Radau: braking time and angle only, at 1e-3, 1e-4 and the bench's tolerance). A solver meets an accuracy level at \
          its cheapest tolerance whose worst error is at or below it at that and every tighter tolerance; the ratio compares those \
          cheapest walls. Chart: `work-precision.svg`.\n\n![work-precision](work-precision.svg)\n\n{wp_md}",
         args.iter().map(|a| format!(" {a}")).collect::<String>()
@@ -134,6 +150,60 @@ pub fn main(args: &[String]) -> Result<i32, String> {
     wp::chart(&path.with_file_name("work-precision.svg"), &pts)?;
     eprintln!("wrote {} and work-precision.svg", path.display());
     Ok(0)
+}
+
+/// scipy Radau at further tolerances (`bench/radau.py`, minutes each), its worst relative error
+/// over braking time and angle against the references the bench printed.
+fn scipy_sweep(bench: &serde_json::Value, tols: &[f64]) -> Result<Vec<Point>, String> {
+    let script = workspace_root().join("bench").join("radau.py");
+    let mut out = Vec::new();
+    for r in bench
+        .get("scenes")
+        .and_then(|s| s.as_array())
+        .into_iter()
+        .flatten()
+    {
+        let (Some(scene), Some(main_tol)) = (
+            r.get("scene").and_then(|v| v.as_str()),
+            r.get("tolerance").and_then(|v| v.as_f64()),
+        ) else {
+            continue;
+        };
+        for &tol in tols.iter().filter(|&&t| t != main_tol) {
+            eprintln!("twin-bench: scipy Radau on {scene} at {tol:e}");
+            let o = Command::new("timeout")
+                .arg("1800")
+                .arg("python3")
+                .arg(&script)
+                .args([scene, "--tolerance", &format!("{tol:e}")])
+                .output()
+                .map_err(|e| format!("starting {}: {e}", script.display()))?;
+            let run: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap_or_default();
+            let Some(wall_s) = run.get("wall_s").and_then(|v| v.as_f64()) else {
+                continue;
+            };
+            let mut worst: Option<f64> = None;
+            for m in ["braking_time_s", "braking_angle_rad"] {
+                let Some(re) = r["reference"].get(m).and_then(|v| v.as_f64()) else {
+                    continue;
+                };
+                let e = run
+                    .get(m)
+                    .and_then(|v| v.as_f64())
+                    .map_or(f64::INFINITY, |v| ((v - re) / re).abs());
+                worst = Some(worst.map_or(e, |w: f64| w.max(e)));
+            }
+            out.push(Point {
+                scene: scene.to_string(),
+                solver: "scipy-radau".into(),
+                tolerance: tol,
+                wall_s,
+                error: worst.filter(|e| e.is_finite()),
+                metric: "braking time / angle".into(),
+            });
+        }
+    }
+    Ok(out)
 }
 
 /// scipy Radau's points from the bench's JSON (one tolerance; error over time and angle).
