@@ -295,13 +295,9 @@ where
             y.copy_from_slice(&yl);
             break;
         }
-        if matches!(reason, OdeSolverStopReason::RootFound(..)) {
-            // A root with no sign change under the twin's rule (grazing): carry on.
-            cell.borrow().events(t, &interp(&solver, t)?, &mut g0);
-        } else {
-            let yl = interp(&solver, t)?;
-            cell.borrow().events(t, &yl, &mut g0);
-        }
+        // A plain step, or a root with no sign change under the twin's rule (grazing): carry on.
+        let yl = interp(&solver, t)?;
+        cell.borrow().events(t, &yl, &mut g0);
     }
     Ok((solver.get_statistics().clone(), events))
 }

@@ -189,7 +189,7 @@ pub fn markdown(pts: &[Point]) -> String {
             p.tolerance,
             eng(p.wall_s),
             p.error
-                .map_or("failed / none".into(), |e| format!("{:.2e}", e)),
+                .map_or("— (no compared metric)".into(), |e| format!("{:.2e}", e)),
             p.metric
         );
     }
