@@ -1,7 +1,7 @@
 //! The integrator: an error-controlled, L-stable linearly-implicit Rosenbrock method with event
-//! location, written here because the state is small (≤ 20) and the stiff-capable crates
-//! (diffsol pulls faer and nalgebra) would multiply the workspace's cold build time
-//! (docs/model.md, "Integrator"). The diffsol peer (`peer` feature) runs the same systems.
+//! location (the default), and the diffsol peer (`peer` feature) behind the same
+//! [`SegmentSolver`]; the peer is faster at matched accuracy but stays opt-in until the goldens
+//! move with it (docs/model.md "Speed", docs/decisions.md issue 18).
 
 pub mod linalg;
 #[cfg(feature = "peer")]
