@@ -1,15 +1,17 @@
 //! Speed benchmark (issue 18): each paper scene of the `physical` reading against its converged
 //! reference (`tests/reference/converged.json`, tolerance 1e-10), timed (best of three) with its
 //! worst relative error, beside the independent scipy `solve_ivp(method="Radau")` solve of the
-//! same equations (`bench/radau.py`) at the same tolerance. A speed ratio is printed only where
-//! both sides hold every compared metric within 1 % of the reference (matched accuracy).
+//! same equations (`bench/radau.py`) and the compiled diffsol BDF peer (`solver::peer`, same
+//! `OdeSystem`, same event rule) at the same tolerance. A speed ratio is printed only where both
+//! sides hold every compared metric within 1 % of the reference (matched accuracy).
 //!
-//! `cargo run --release -p noback-twin --example bench -- [--tolerance TOL] [--no-scipy] [--json]`
+//! `cargo run --release -p noback-twin --features peer --example bench -- [--tolerance TOL] [--no-scipy] [--json | --json-out PATH]`
 use noback_twin::convergence::{self, Entry};
 use noback_twin::metrics;
 use noback_twin::reading::Reading;
 use noback_twin::scene::{Scene, SceneKind};
 use noback_twin::sim;
+use noback_twin::solver::peer::{Method, Peer};
 use serde_json::{json, Value};
 
 /// The metrics both sides report (scipy's script reports only these).
@@ -57,8 +59,8 @@ fn main() {
     let script = format!("{root}/bench/radau.py");
     let mut rows: Vec<Value> = Vec::new();
     if !as_json {
-        println!("| scene | reference braking time / angle (1e-10) | twin wall (s) | twin RHS evals | twin worst error | scipy Radau wall (s) | scipy RHS evals | scipy braking time / angle | scipy worst error | ratio at matched accuracy |");
-        println!("|---|---|---|---|---|---|---|---|---|---|");
+        println!("| scene | reference braking time / angle (1e-10) | twin wall (s) | twin RHS evals | twin worst error | diffsol BDF wall (s) | diffsol worst error | diffsol / twin wall | scipy Radau wall (s) | scipy RHS evals | scipy braking time / angle | scipy worst error | scipy / twin wall at matched accuracy |");
+        println!("|---|---|---|---|---|---|---|---|---|---|---|---|---|");
     }
     for kind in [
         SceneKind::ReverseLoad,
@@ -83,6 +85,20 @@ fn main() {
             }
         }
         let Some(m) = last else { continue };
+        let mut ds_best = f64::INFINITY;
+        let mut ds_last = None;
+        for _ in 0..3 {
+            match sim::run_with(&s, Peer::new(Method::Bdf, sim::solver_options(&s))) {
+                Ok(r) => {
+                    ds_best = ds_best.min(r.wall_s);
+                    ds_last = Some(metrics::compute(&s, &r.samples, &r.stats, r.wall_s));
+                }
+                Err(e) => eprintln!("{} (diffsol): {e}", kind.name()),
+            }
+        }
+        let ds_err = ds_last
+            .as_ref()
+            .and_then(|d| worst(&refs, kind.name(), &|n| convergence::metric(d, n)));
         let twin_err = worst(&refs, kind.name(), &|n| convergence::metric(&m, n));
         let reference = |n: &str| {
             refs.iter()
@@ -124,6 +140,8 @@ fn main() {
             "tolerance": tol,
             "reference": {"tolerance": 1e-10, "braking_time_s": reference("braking_time_s"), "braking_angle_rad": reference("braking_angle_rad")},
             "twin": {"wall_s": best, "rhs_evals": m.rhs_evals, "braking_time_s": m.braking_time_s, "braking_angle_rad": m.braking_angle_rad, "worst_rel_error": twin_err},
+            "diffsol_bdf": ds_last.as_ref().map(|d| json!({"wall_s": ds_best, "rhs_evals": d.rhs_evals, "braking_time_s": d.braking_time_s, "braking_angle_rad": d.braking_angle_rad, "worst_rel_error": ds_err})),
+            "diffsol_ratio_at_matched_accuracy": (matched(twin_err) && matched(ds_err)).then(|| ds_best / best),
             "scipy_radau": {"run": py, "worst_rel_error": py_err},
             "ratio_at_matched_accuracy": ratio,
         }));
@@ -133,13 +151,26 @@ fn main() {
                 |v: Option<f64>| v.map_or("—".to_string(), |v| format!("{:.2} %", 100.0 * v));
             let pf = |n: &str| py.get(n).and_then(Value::as_f64);
             println!(
-                "| {} | {} / {} | {:.4} | {} | {} | {} | {} | {} / {} | {} | {} |",
+                "| {} | {} / {} | {:.4} | {} | {} | {} | {} | {} | {} | {} | {} / {} | {} | {} |",
                 kind.name(),
                 o(reference("braking_time_s")),
                 o(reference("braking_angle_rad")),
                 best,
                 m.rhs_evals,
                 pct(twin_err),
+                if ds_best.is_finite() {
+                    format!("{ds_best:.4}")
+                } else {
+                    "failed".into()
+                },
+                pct(ds_err),
+                if matched(twin_err) && matched(ds_err) {
+                    format!("{:.2}", ds_best / best)
+                } else if twin_err.is_none() {
+                    "— (no compared metric)".into()
+                } else {
+                    "— (not matched)".into()
+                },
                 py_wall.map_or("—".into(), |w| format!("{w:.2}")),
                 py.get("rhs_evals")
                     .and_then(Value::as_u64)
@@ -158,5 +189,14 @@ fn main() {
     }
     if as_json {
         println!("{}", json!({ "scenes": rows }));
+    } else if let Some(p) = args
+        .iter()
+        .position(|a| a == "--json-out")
+        .and_then(|i| args.get(i + 1))
+    {
+        if let Err(e) = std::fs::write(p, json!({ "scenes": rows }).to_string()) {
+            eprintln!("{p}: {e}");
+            std::process::exit(2);
+        }
     }
 }

@@ -7,7 +7,7 @@ use crate::model::physical::Physical;
 use crate::model::{Drive, ModelConfig, Sample, TwinModel};
 use crate::reading::Reading;
 use crate::scene::{Scene, SceneKind};
-use crate::solver::{Integrator, Sampler, SolverError, SolverOptions, SolverStats};
+use crate::solver::{Integrator, Sampler, SegmentSolver, SolverError, SolverOptions, SolverStats};
 
 /// Trace and sample rate (Hz): the monitor's 10 kHz.
 pub const SAMPLE_RATE_HZ: f64 = 10_000.0;
@@ -62,8 +62,26 @@ pub fn solver_options(scene: &Scene) -> SolverOptions {
     }
 }
 
+/// Run a scene under its reading with a given integrator (the twin's, or a peer).
+pub fn run_with<I: SegmentSolver>(scene: &Scene, integ: I) -> Result<Run, SolverError> {
+    let cfg = model_config(scene);
+    match scene.reading {
+        Reading::Paper => run_model_with(scene, Paper::new(cfg), integ),
+        Reading::Physical => run_model_with(scene, Physical::new(cfg), integ),
+    }
+}
+
 /// Run a scene with a given model.
-pub fn run_model<M: TwinModel>(scene: &Scene, mut model: M) -> Result<Run, SolverError> {
+pub fn run_model<M: TwinModel>(scene: &Scene, model: M) -> Result<Run, SolverError> {
+    run_model_with(scene, model, Integrator::new(solver_options(scene)))
+}
+
+/// Run a scene with a given model and integrator.
+pub fn run_model_with<M: TwinModel, I: SegmentSolver>(
+    scene: &Scene,
+    mut model: M,
+    mut integ: I,
+) -> Result<Run, SolverError> {
     let start = std::time::Instant::now();
     let mut y = model.initial_state();
     let mut breaks: Vec<f64> = scene
@@ -85,7 +103,6 @@ pub fn run_model<M: TwinModel>(scene: &Scene, mut model: M) -> Result<Run, Solve
     model.set_faults(faults0, &mut y);
     samples.push(model.sample(0.0, &y));
     let mut smp = Sampler::new(dt, dt);
-    let mut integ = Integrator::new(solver_options(scene));
     let mut t = 0.0;
     let speed = scene.signed_initial_speed_rad_s();
     for &b in &breaks {
@@ -111,7 +128,7 @@ pub fn run_model<M: TwinModel>(scene: &Scene, mut model: M) -> Result<Run, Solve
     }
     Ok(Run {
         samples,
-        stats: integ.stats,
+        stats: integ.stats(),
         wall_s: start.elapsed().as_secs_f64(),
     })
 }

@@ -98,6 +98,13 @@ pub enum SolverError {
         /// Time reached (s).
         t_s: f64,
     },
+    /// A peer solver's own error (the `peer` feature), with its message.
+    Peer {
+        /// Time (s).
+        t_s: f64,
+        /// The peer's message.
+        message: String,
+    },
 }
 
 impl std::fmt::Display for SolverError {
@@ -114,6 +121,7 @@ impl std::fmt::Display for SolverError {
             SolverError::EventLoop { t_s } => {
                 write!(f, "events fire without time advancing at t = {t_s:.6} s")
             }
+            SolverError::Peer { t_s, message } => write!(f, "peer at t = {t_s:.6} s: {message}"),
         }
     }
 }

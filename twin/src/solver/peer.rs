@@ -1,0 +1,303 @@
+//! The compiled peer (issue 18): the same [`OdeSystem`] integrated by diffsol (BDF, or the
+//! TR-BDF2 / ESDIRK34 SDIRK methods) with diffsol's root finding; at a root the twin's own event
+//! rule (the functions that changed sign) and `on_event` apply, then diffsol re-initialises.
+//! Built only with the `peer` feature (`cargo xtask twin-bench` turns it on).
+
+use super::{OdeSystem, Sampler, SegmentSolver, SolverError, SolverOptions, SolverStats};
+use diffsol::{
+    NalgebraLU, NalgebraMat, NalgebraVec, OdeBuilder, OdeEquationsImplicit, OdeSolverMethod,
+    OdeSolverStopReason, Vector,
+};
+use std::cell::{Cell, RefCell};
+
+type M = NalgebraMat<f64>;
+type LS = NalgebraLU<f64>;
+
+/// Which diffsol method.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Method {
+    /// Variable-order BDF (like ode15s / CVODE).
+    Bdf,
+    /// TR-BDF2 SDIRK (like ode23tb).
+    TrBdf2,
+    /// ESDIRK34.
+    Esdirk34,
+}
+
+impl Method {
+    /// Short name used on the pages.
+    pub fn name(self) -> &'static str {
+        match self {
+            Method::Bdf => "diffsol-bdf",
+            Method::TrBdf2 => "diffsol-trbdf2",
+            Method::Esdirk34 => "diffsol-esdirk34",
+        }
+    }
+}
+
+/// A diffsol integrator behind the twin's segment interface.
+pub struct Peer {
+    /// Method.
+    pub method: Method,
+    /// Tolerance and step limits (max step is applied as a stop time; min step as an error).
+    pub options: SolverOptions,
+    /// Work counters (steps, rejected = error-test failures, RHS evaluations, events).
+    pub stats: SolverStats,
+}
+
+impl Peer {
+    /// A peer with the twin's options.
+    pub fn new(method: Method, options: SolverOptions) -> Self {
+        Peer {
+            method,
+            options,
+            stats: SolverStats::default(),
+        }
+    }
+}
+
+fn changed(g0: f64, g1: f64) -> bool {
+    (g0 > 0.0 && g1 <= 0.0) || (g0 < 0.0 && g1 >= 0.0)
+}
+
+fn err(t: f64) -> impl Fn(diffsol::DiffsolError) -> SolverError {
+    move |e| SolverError::Peer {
+        t_s: t,
+        message: e.to_string(),
+    }
+}
+
+impl SegmentSolver for Peer {
+    fn stats(&self) -> SolverStats {
+        self.stats
+    }
+
+    fn integrate<S: OdeSystem>(
+        &mut self,
+        sys: &mut S,
+        (t0, t1): (f64, f64),
+        y: &mut [f64],
+        sampler: &mut Sampler,
+        observe: &mut dyn FnMut(&S, f64, &[f64]),
+    ) -> Result<(), SolverError> {
+        let n = sys.dim();
+        let ne = sys.event_count().max(1);
+        let scales = sys.scales();
+        let tol = self.options.tolerance;
+        let atol: Vec<f64> = scales.iter().map(|s| tol * s.abs().max(1e-300)).collect();
+        let cell = RefCell::new(sys);
+        let rhs_count = Cell::new(0u64);
+        let start = RefCell::new(y.to_vec());
+        let f = |x: &[f64], _p: &[f64], t: f64, dy: &mut [f64]| {
+            rhs_count.set(rhs_count.get() + 1);
+            cell.borrow().rhs(t, x, dy);
+        };
+        // J·v by a forward difference scaled like the twin's Jacobian columns.
+        let jv = |x: &[f64], _p: &[f64], t: f64, v: &[f64], out: &mut [f64]| {
+            let s = v
+                .iter()
+                .zip(&scales)
+                .map(|(vi, si)| vi.abs() / si.abs().max(1e-30))
+                .fold(0.0, f64::max);
+            if s == 0.0 {
+                out.iter_mut().for_each(|o| *o = 0.0);
+                return;
+            }
+            let eps = 1e-7 / s;
+            let xp: Vec<f64> = x.iter().zip(v).map(|(a, b)| a + eps * b).collect();
+            let mut f0 = vec![0.0; x.len()];
+            let sys = cell.borrow();
+            sys.rhs(t, x, &mut f0);
+            sys.rhs(t, &xp, out);
+            rhs_count.set(rhs_count.get() + 2);
+            for (o, a) in out.iter_mut().zip(&f0) {
+                *o = (*o - a) / eps;
+            }
+        };
+        // diffsol wants at least one root function: a constant one when the system has none.
+        let real = sys_events(&cell);
+        let root = |x: &[f64], _p: &[f64], t: f64, g: &mut [f64]| {
+            g.iter_mut().for_each(|v| *v = 1.0);
+            if let Some(head) = g.get_mut(..real) {
+                cell.borrow().events(t, x, head);
+            }
+        };
+        let mut problem = OdeBuilder::<M>::new()
+            .t0(t0)
+            .h0((self.options.max_step_s * 1e-3).max(1e-9))
+            .rtol(tol)
+            .atol(atol)
+            .rhs_implicit(f, jv)
+            .init(
+                |_p: &[f64], _t: f64, y0: &mut [f64]| y0.copy_from_slice(&start.borrow()),
+                n,
+            )
+            .root(root, ne)
+            .build()
+            .map_err(err(t0))?;
+        // diffsol counts Newton failures over the solver's whole life (50 by default); a contact
+        // run has thousands of harmless ones, so only the minimum step stops it.
+        problem.ode_options.max_nonlinear_solver_failures = usize::MAX / 2;
+        problem.ode_options.min_timestep = self.options.min_step_s;
+        let r = match self.method {
+            Method::Bdf => run(
+                problem.bdf::<LS>().map_err(err(t0))?,
+                &cell,
+                (t0, t1),
+                y,
+                sampler,
+                observe,
+                &self.options,
+            ),
+            Method::TrBdf2 => run(
+                problem.tr_bdf2::<LS>().map_err(err(t0))?,
+                &cell,
+                (t0, t1),
+                y,
+                sampler,
+                observe,
+                &self.options,
+            ),
+            Method::Esdirk34 => run(
+                problem.esdirk34::<LS>().map_err(err(t0))?,
+                &cell,
+                (t0, t1),
+                y,
+                sampler,
+                observe,
+                &self.options,
+            ),
+        };
+        let (st, events) = r?;
+        self.stats.steps += st.number_of_steps as u64;
+        self.stats.rejected += st.number_of_error_test_failures as u64;
+        self.stats.jacobians += st.number_of_linear_solver_setups as u64;
+        self.stats.events += events;
+        self.stats.rhs_evals += rhs_count.get();
+        Ok(())
+    }
+}
+
+fn sys_events<S: OdeSystem>(cell: &RefCell<&mut S>) -> usize {
+    cell.borrow().event_count()
+}
+
+/// Step `solver` to `t1`: samples from the interpolant, events by the twin's rule at each root.
+fn run<'a, S, Eqn, Sol>(
+    mut solver: Sol,
+    cell: &RefCell<&mut S>,
+    (t0, t1): (f64, f64),
+    y: &mut [f64],
+    sampler: &mut Sampler,
+    observe: &mut dyn FnMut(&S, f64, &[f64]),
+    options: &SolverOptions,
+) -> Result<(diffsol::ode_solver::OdeSolverStatistics, u64), SolverError>
+where
+    S: OdeSystem,
+    Eqn: OdeEquationsImplicit<T = f64, V = NalgebraVec<f64>> + 'a,
+    Sol: OdeSolverMethod<'a, Eqn>,
+{
+    let ne = cell.borrow().event_count();
+    let mut g0 = vec![0.0; ne];
+    let mut gm = vec![0.0; ne];
+    cell.borrow().events(t0, y, &mut g0);
+    let mut t = t0;
+    let mut events = 0u64;
+    let mut last_event_t = f64::NAN;
+    let mut events_here = 0u32;
+    let mut steps = 0u64;
+    solver.set_stop_time(t1).map_err(err(t0))?;
+    let interp = |s: &Sol, tm: f64| -> Result<Vec<f64>, SolverError> {
+        s.interpolate(tm).map(|v| v.clone_as_vec()).map_err(err(tm))
+    };
+    loop {
+        steps += 1;
+        if steps > options.max_steps {
+            return Err(SolverError::TooManySteps { t_s: t });
+        }
+        let reason = solver.step().map_err(|e| SolverError::Peer {
+            t_s: solver.state().t,
+            message: e.to_string(),
+        })?;
+        let t_step = solver.state().t;
+        let (t_end, fired) = match reason {
+            OdeSolverStopReason::RootFound(tr, _) => {
+                // The twin's rule: the functions changed between the last restart and just
+                // past the root (bisection on diffsol's interpolant up to the step end).
+                let (mut lo, mut hi) = (tr.min(t_step), t_step);
+                let first = |tm: f64, gm: &mut [f64]| -> Result<bool, SolverError> {
+                    let ym = interp(&solver, tm)?;
+                    cell.borrow().events(tm, &ym, gm);
+                    Ok(g0.iter().zip(gm.iter()).any(|(&a, &b)| changed(a, b)))
+                };
+                if first(lo, &mut gm)? {
+                    hi = lo;
+                } else {
+                    let t_tol = 1e-13_f64.max(1e-12 * t.abs());
+                    while hi - lo > t_tol {
+                        let mid = 0.5 * (lo + hi);
+                        if first(mid, &mut gm)? {
+                            hi = mid;
+                        } else {
+                            lo = mid;
+                        }
+                    }
+                    first(hi, &mut gm)?;
+                }
+                let fired: Vec<usize> = (0..ne).filter(|&i| changed(g0[i], gm[i])).collect();
+                (hi, fired)
+            }
+            _ => (t_step, Vec::new()),
+        };
+        while sampler.next_s <= t_end + 1e-12 * t_end.abs().max(1.0) && sampler.next_s <= t1 + 1e-12
+        {
+            let ym = interp(&solver, sampler.next_s.min(t_step))?;
+            observe(&**cell.borrow(), sampler.next_s, &ym);
+            sampler.next_s += sampler.dt_s;
+        }
+        if !fired.is_empty() {
+            let mut ye = interp(&solver, t_end)?;
+            cell.borrow_mut().on_event(t_end, &mut ye, &fired);
+            if ye.iter().any(|v| !v.is_finite()) {
+                return Err(SolverError::NonFinite { t_s: t_end });
+            }
+            events += 1;
+            if (t_end - last_event_t).abs() < 1e-10 {
+                events_here += 1;
+                if events_here > 200 {
+                    return Err(SolverError::EventLoop { t_s: t_end });
+                }
+            } else {
+                events_here = 0;
+            }
+            last_event_t = t_end;
+            cell.borrow().events(t_end, &ye, &mut g0);
+            let mut dy = vec![0.0; ye.len()];
+            cell.borrow().rhs(t_end, &ye, &mut dy);
+            let ctx = *solver.state().y.context();
+            {
+                let st = solver.state_mut();
+                st.y.copy_from(&NalgebraVec::from_slice(&ye, ctx));
+                st.dy.copy_from(&NalgebraVec::from_slice(&dy, ctx));
+                *st.t = t_end;
+            }
+            t = t_end;
+            y.copy_from_slice(&ye);
+            if t1 - t <= 1e-15 * t1.abs().max(1.0) {
+                break;
+            }
+            solver.set_stop_time(t1).map_err(err(t))?;
+            continue;
+        }
+        t = t_step;
+        if matches!(reason, OdeSolverStopReason::TstopReached) || t >= t1 {
+            let yl = interp(&solver, t)?;
+            y.copy_from_slice(&yl);
+            break;
+        }
+        // A plain step, or a root with no sign change under the twin's rule (grazing): carry on.
+        let yl = interp(&solver, t)?;
+        cell.borrow().events(t, &yl, &mut g0);
+    }
+    Ok((solver.get_statistics().clone(), events))
+}
