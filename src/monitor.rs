@@ -117,8 +117,6 @@ struct State {
     energy: Energy,
     checks: Checks,
     flags: Flags,
-    /// The last tick's slow-lane work, until [`Monitor::background`] runs it.
-    job: Option<Job>,
     /// The last slow-lane run's results, until the next tick applies them.
     slow: SlowResult,
 }
@@ -128,6 +126,10 @@ struct State {
 pub struct Monitor {
     settings: Settings,
     state: State,
+    /// The last tick's slow-lane work (sensing and the observer write it in place).
+    job: Job,
+    /// `job` waits for [`Monitor::background`].
+    job_due: bool,
 }
 
 impl Monitor {
@@ -157,9 +159,14 @@ impl Monitor {
                 energy: Energy::new(),
                 checks: Checks::new(),
                 flags: Flags::default(),
-                job: None,
                 slow: SlowResult::NONE,
             },
+            job: Job {
+                slot: Slot::Free,
+                x: Sensed::NONE,
+                o: Observed::NONE,
+            },
+            job_due: false,
         };
         monitor.state.refresh_load(&monitor.settings);
         Ok(monitor)
@@ -202,15 +209,17 @@ impl Monitor {
     /// feed-forward; latches the flags and reports. The slow lane's results it uses are those
     /// of the previous [`Monitor::background`].
     pub fn tick(&mut self, inputs: &Inputs) -> Estimate {
-        let (k, st) = (&self.settings, &mut self.state);
+        let (k, st, job) = (&self.settings, &mut self.state, &mut self.job);
         // Schedule.
         let n = u32::from(inputs.ticks_elapsed.max(1));
         st.tick = st.tick.wrapping_add(n); // modular on purpose
-        let slot = Slot::of(st.tick);
+        job.slot = Slot::of(st.tick);
         // Sense and observe.
         let carrying = st.classify.scene() == Scene::Driving;
-        let x = st.sense.read(&k.sense, inputs, n, carrying);
-        let o = st.observe.update(&k.observe, &x);
+        job.x = st.sense.read(&k.sense, inputs, n, carrying);
+        let x = &job.x;
+        job.o = st.observe.update(&k.observe, x);
+        let o = &job.o;
         if x.first {
             // Until the first classification (the next background): the pack at rest as the
             // drive command leaves it, untrusted.
@@ -225,8 +234,8 @@ impl Monitor {
                 )
             };
         }
-        st.classify.tick(&x, &o);
-        st.checks.events(&k.checks, &x, &o);
+        st.classify.tick(x, o);
+        st.checks.events(&k.checks, x, o);
         if x.drive_edge && x.drive {
             st.load.drive_started();
         }
@@ -241,7 +250,7 @@ impl Monitor {
             load_abs: st.load.estimate.value().saturating_abs(),
             capacity: st.load.cache.capacity,
         });
-        let (fast, gave_way) = st.checks.every_tick(&k.checks, &x, &o, braking);
+        let (fast, gave_way) = st.checks.every_tick(&k.checks, x, o, braking);
         if gave_way || st.slow.gave_way {
             st.classify.lose_hold();
         }
@@ -263,27 +272,28 @@ impl Monitor {
         raised.overrun |= n > 1;
         st.flags = st.flags.union(raised);
         st.slow = SlowResult::NONE;
-        st.job = Some(Job { slot, x, o });
-        st.report(&o)
+        self.job_due = true;
+        st.report(o)
     }
 
     /// The slow lane's work for the last [`Monitor::tick`] (one slot of classify, estimate,
     /// checks, window), run at a lower priority before the next tick; its results reach the
     /// next tick. Does nothing when called twice.
     pub fn background(&mut self) {
-        let (k, st) = (&self.settings, &mut self.state);
-        let Some(Job { slot, x, o }) = st.job.take() else {
+        if !core::mem::take(&mut self.job_due) {
             return;
-        };
+        }
+        let (k, st) = (&self.settings, &mut self.state);
+        let Job { slot, ref x, ref o } = self.job;
         let mut reading_switch = false;
         match slot {
             _ if x.first => {
-                reading_switch = st.classify(k, &x, &o);
+                reading_switch = st.classify(k, x, o);
                 st.estimate(k);
             }
-            Slot::Classify => reading_switch = st.classify(k, &x, &o),
+            Slot::Classify => reading_switch = st.classify(k, x, o),
             Slot::Estimate => st.estimate(k),
-            Slot::Sync if x.drive => st.classify.sync_window(&k.scene, &x, o.w),
+            Slot::Sync if x.drive => st.classify.sync_window(&k.scene, x, o.w),
             _ => {}
         }
         let ci = CheckInputs {
@@ -291,15 +301,9 @@ impl Monitor {
             drive_drag: k.pack.drive_drag,
             min_load: k.scene.min_load,
         };
-        let (raised, gave_way) = st.checks.slow(
-            &k.checks,
-            &x,
-            &o,
-            &st.observed,
-            &st.classified,
-            &st.load,
-            &ci,
-        );
+        let (raised, gave_way) =
+            st.checks
+                .slow(&k.checks, x, o, &st.observed, &st.classified, &st.load, &ci);
         st.slow = SlowResult {
             raised,
             gave_way,

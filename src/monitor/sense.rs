@@ -166,6 +166,24 @@ pub(crate) struct Sensed {
     pub early_fault: bool,
 }
 
+impl Sensed {
+    /// Before the first call.
+    pub const NONE: Sensed = Sensed {
+        n: 0,
+        drive: false,
+        drive_edge: false,
+        first: false,
+        out: 0,
+        motor: 0,
+        angle: 0,
+        d_out: 0,
+        out_ok: false,
+        current: 0,
+        fault: false,
+        early_fault: false,
+    };
+}
+
 /// The sensors' memory.
 #[derive(Clone, Debug)]
 pub(crate) struct Sense {
