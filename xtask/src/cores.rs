@@ -1,8 +1,9 @@
-//! The three emulated Cortex-M cores we test on, and how QEMU boots each.
+//! The emulated Cortex-M cores we test on, and how QEMU boots each.
 //!
-//! One memory map (`memory.x`: 256 K flash at 0x0, 64 K RAM at 0x2000_0000) fits both boards.
+//! One memory map (`memory.x`: 256 K flash at 0x0, 64 K RAM at 0x2000_0000) fits every board.
 //! Hard-float code faults on lm3s6965evb at its first VFP instruction, so the M4F runs on
-//! mps2-an386, which has the FPU.
+//! mps2-an386, which has the FPU. The M7 (mps2-an500) runs the M4F's image: same target, so
+//! the cargo runner's tests (which pick the core from the target) run on the M4F only.
 
 /// A core under test.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -13,11 +14,15 @@ pub enum Core {
     M3,
     /// Cortex-M4 with FPU (ARMv7E-M, hard float): mps2-an386.
     M4f,
+    /// Cortex-M7 with FPU (ARMv7E-M, hard float): mps2-an500, the M4F's image.
+    M7,
 }
 
 impl Core {
-    /// Every core, in test order.
+    /// The cores with a target of their own, in test order (every test stage runs on each).
     pub const ALL: [Core; 3] = [Core::M0, Core::M3, Core::M4f];
+    /// Every core `--core` accepts: `ALL` and the M7, which shares the M4F's target.
+    pub const EVERY: [Core; 4] = [Core::M0, Core::M3, Core::M4f, Core::M7];
 
     /// Name on the command line.
     pub fn name(self) -> &'static str {
@@ -25,6 +30,7 @@ impl Core {
             Core::M0 => "m0",
             Core::M3 => "m3",
             Core::M4f => "m4f",
+            Core::M7 => "m7",
         }
     }
 
@@ -33,7 +39,7 @@ impl Core {
         match self {
             Core::M0 => "thumbv6m-none-eabi",
             Core::M3 => "thumbv7m-none-eabi",
-            Core::M4f => "thumbv7em-none-eabihf",
+            Core::M4f | Core::M7 => "thumbv7em-none-eabihf",
         }
     }
 
@@ -43,6 +49,7 @@ impl Core {
             Core::M0 => ("lm3s6965evb", "cortex-m0"),
             Core::M3 => ("lm3s6965evb", "cortex-m3"),
             Core::M4f => ("mps2-an386", "cortex-m4"),
+            Core::M7 => ("mps2-an500", "cortex-m7"),
         }
     }
 
@@ -51,7 +58,7 @@ impl Core {
     pub fn systick_clock_hz(self) -> f64 {
         match self {
             Core::M0 | Core::M3 => 12.5e6,
-            Core::M4f => 25.0e6,
+            Core::M4f | Core::M7 => 25.0e6,
         }
     }
 
@@ -60,12 +67,12 @@ impl Core {
         f64::from(1_u32 << shift) * 1e-9 * self.systick_clock_hz()
     }
 
-    /// Parses a command-line name (`m0`, `m3`, `m4f`).
+    /// Parses a command-line name (`m0`, `m3`, `m4f`, `m7`).
     pub fn parse(name: &str) -> Result<Core, String> {
-        Core::ALL
+        Core::EVERY
             .into_iter()
             .find(|c| c.name() == name)
-            .ok_or_else(|| format!("unknown core `{name}` (expected m0, m3 or m4f)"))
+            .ok_or_else(|| format!("unknown core `{name}` (expected m0, m3, m4f or m7)"))
     }
 
     /// The core whose target triple appears in a build path, e.g.
@@ -86,7 +93,13 @@ mod tests {
             let path = format!("/w/target/{}/release/noback-fw", core.triple());
             assert_eq!(Core::from_path(&path), Some(core));
         }
-        assert!(Core::parse("m7").is_err());
+        assert_eq!(Core::parse("m7"), Ok(Core::M7));
+        // A path names its target, which the M7 shares with the M4F: the runner takes the M4F.
+        assert_eq!(
+            Core::from_path("/w/target/thumbv7em-none-eabihf/debug/deps/on_target-1"),
+            Some(Core::M4f)
+        );
+        assert!(Core::parse("m9").is_err());
         assert_eq!(Core::from_path("target/debug/xtask"), None);
     }
 }

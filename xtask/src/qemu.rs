@@ -165,7 +165,7 @@ pub struct QemuArgs {
     /// The image to boot.
     pub elf: String,
     /// The emulated core (default: from the target triple in the ELF's path).
-    #[arg(long, value_parser = crate::core_arg, value_name = "m0|m3|m4f")]
+    #[arg(long, value_parser = crate::core_arg, value_name = "m0|m3|m4f|m7")]
     pub core: Option<Core>,
     /// Wall-clock limit in seconds; a run past it ends with exit 124.
     #[arg(long, allow_hyphen_values = true, value_parser = positive_seconds, default_value_t = 60.0, value_name = "S")]
@@ -185,7 +185,7 @@ pub fn main(a: &QemuArgs) -> Result<i32, String> {
         return Ok(noback_twin::args::bad_input(
             "qemu",
             &format!(
-                "cannot tell the core from `{}`: pass --core m0|m3|m4f",
+                "cannot tell the core from `{}`: pass --core m0|m3|m4f|m7",
                 noback_twin::args::short(&a.elf)
             ),
         ));

@@ -33,7 +33,7 @@ pub struct RunArgs {
     #[arg(long, value_name = "NAME|FILE|stress", default_value = "reverse_load")]
     pub scene: String,
     /// The emulated core.
-    #[arg(long, value_parser = crate::core_arg, default_value = "m3", value_name = "m0|m3|m4f")]
+    #[arg(long, value_parser = crate::core_arg, default_value = "m3", value_name = "m0|m3|m4f|m7")]
     pub core: Core,
     /// Print the summary as one JSON object.
     #[arg(long)]
