@@ -383,19 +383,23 @@ pub fn build_package_bin(
 /// Mean and largest instructions per step from a bench line's `steps`, `ticks_sum` and
 /// `ticks_max` (SysTick ticks under `-icount shift=BENCH_SHIFT` on `core`).
 pub fn step_insns(line: &BTreeMap<&str, &str>, core: Core) -> Result<(f64, f64), String> {
-    let steps: f64 = field::<u32>(line, "steps")?.into();
-    let sum = field::<u64>(line, "ticks_sum")? as f64;
-    let max: f64 = field::<u32>(line, "ticks_max")?.into();
-    let per = core.ticks_per_insn(BENCH_SHIFT);
-    Ok((sum / steps.max(1.0) / per, max / per))
+    insns_per_call(line, core, "ticks")
 }
 
-/// Mean and largest instructions per `Monitor::background` call from a bench line's
-/// `bg_ticks_sum` and `bg_ticks_max`.
+/// The same per `Monitor::background` call, from `bg_ticks_sum` and `bg_ticks_max`.
 pub fn background_insns(line: &BTreeMap<&str, &str>, core: Core) -> Result<(f64, f64), String> {
+    insns_per_call(line, core, "bg_ticks")
+}
+
+/// Mean and largest instructions per call from a bench line's `steps`, `{key}_sum`, `{key}_max`.
+fn insns_per_call(
+    line: &BTreeMap<&str, &str>,
+    core: Core,
+    key: &str,
+) -> Result<(f64, f64), String> {
     let steps: f64 = field::<u32>(line, "steps")?.into();
-    let sum = field::<u64>(line, "bg_ticks_sum")? as f64;
-    let max: f64 = field::<u32>(line, "bg_ticks_max")?.into();
+    let sum = field::<u64>(line, &format!("{key}_sum"))? as f64;
+    let max: f64 = field::<u32>(line, &format!("{key}_max"))?.into();
     let per = core.ticks_per_insn(BENCH_SHIFT);
     Ok((sum / steps.max(1.0) / per, max / per))
 }

@@ -8,7 +8,9 @@ pub mod linalg;
 pub mod peer;
 pub mod rosenbrock;
 
-pub use rosenbrock::{Integrator, OdeSystem, Sampler, SolverError, SolverOptions, SolverStats};
+pub use rosenbrock::{
+    EventLoopGuard, Integrator, OdeSystem, Sampler, SolverError, SolverOptions, SolverStats,
+};
 
 /// Anything that integrates an [`OdeSystem`] over one segment with samples and events.
 pub trait SegmentSolver {

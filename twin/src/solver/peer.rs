@@ -3,7 +3,9 @@
 //! rule (the functions that changed sign) and `on_event` apply, then diffsol re-initialises.
 //! Built only with the `peer` feature (`cargo xtask twin-bench` turns it on).
 
-use super::{OdeSystem, Sampler, SegmentSolver, SolverError, SolverOptions, SolverStats};
+use super::{
+    EventLoopGuard, OdeSystem, Sampler, SegmentSolver, SolverError, SolverOptions, SolverStats,
+};
 use diffsol::{
     NalgebraLU, NalgebraMat, NalgebraVec, OdeBuilder, OdeEquationsImplicit, OdeSolverMethod,
     OdeSolverStopReason, Vector,
@@ -203,8 +205,7 @@ where
     cell.borrow().events(t0, y, &mut g0);
     let mut t = t0;
     let mut events = 0u64;
-    let mut last_event_t = f64::NAN;
-    let mut events_here = 0u32;
+    let mut guard = EventLoopGuard::default();
     let mut steps = 0u64;
     solver.set_stop_time(t1).map_err(err(t0))?;
     let interp = |s: &Sol, tm: f64| -> Result<Vec<f64>, SolverError> {
@@ -262,15 +263,7 @@ where
                 return Err(SolverError::NonFinite { t_s: t_end });
             }
             events += 1;
-            if (t_end - last_event_t).abs() < 1e-10 {
-                events_here += 1;
-                if events_here > 200 {
-                    return Err(SolverError::EventLoop { t_s: t_end });
-                }
-            } else {
-                events_here = 0;
-            }
-            last_event_t = t_end;
+            guard.fired(t_end)?;
             cell.borrow().events(t_end, &ye, &mut g0);
             let mut dy = vec![0.0; ye.len()];
             cell.borrow().rhs(t_end, &ye, &mut dy);

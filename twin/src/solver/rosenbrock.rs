@@ -68,6 +68,44 @@ pub struct SolverStats {
     pub events: u64,
 }
 
+/// Events firing again and again at (within 1e-10 s of) one time: more than 200 is an event
+/// loop, an error rather than a hang. One guard per integration, shared by both solvers.
+#[derive(Clone, Copy, Debug)]
+pub struct EventLoopGuard {
+    last_t: f64,
+    here: u32,
+}
+
+impl Default for EventLoopGuard {
+    fn default() -> Self {
+        EventLoopGuard {
+            last_t: f64::NAN,
+            here: 0,
+        }
+    }
+}
+
+impl EventLoopGuard {
+    /// A step without an event ends any run of them.
+    pub fn step(&mut self) {
+        self.here = 0;
+    }
+
+    /// An event fired at `t`.
+    pub fn fired(&mut self, t: f64) -> Result<(), SolverError> {
+        if (t - self.last_t).abs() < 1e-10 {
+            self.here += 1;
+            if self.here > 200 {
+                return Err(SolverError::EventLoop { t_s: t });
+            }
+        } else {
+            self.here = 0;
+        }
+        self.last_t = t;
+        Ok(())
+    }
+}
+
 /// Why an integration failed.
 #[derive(Clone, Debug, PartialEq)]
 pub enum SolverError {
@@ -243,8 +281,7 @@ impl Integrator {
         let mut gm = vec![0.0; ne];
         let mut ym = vec![0.0; n];
         let mut fresh = true; // f0, J and g0 must be recomputed
-        let mut events_here = 0u32;
-        let mut last_event_t = f64::NAN;
+        let mut guard = EventLoopGuard::default();
         let mut attempts = 0u64;
         if self.h <= 0.0 {
             self.h = (self.options.max_step_s * 1e-3).max(1e-9);
@@ -458,7 +495,7 @@ impl Integrator {
                 self.h = h * grow;
                 // The Jacobian is re-evaluated at every step point (Rosenbrock methods need it).
                 fresh = true;
-                events_here = 0;
+                guard.step();
             } else {
                 let t_start = step.t0;
                 step.eval(t_end, &mut ym);
@@ -469,15 +506,7 @@ impl Integrator {
                 if y.iter().any(|v| !v.is_finite()) {
                     return Err(SolverError::NonFinite { t_s: t });
                 }
-                if (t - last_event_t).abs() < 1e-10 {
-                    events_here += 1;
-                    if events_here > 200 {
-                        return Err(SolverError::EventLoop { t_s: t });
-                    }
-                } else {
-                    events_here = 0;
-                }
-                last_event_t = t;
+                guard.fired(t)?;
                 self.h =
                     (h * grow).min((t_end - t_start).max(self.options.min_step_s * 10.0) * 2.0);
                 fresh = true;
