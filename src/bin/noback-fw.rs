@@ -28,19 +28,8 @@ mod target {
     use cortex_m::peripheral::{syst::SystClkSource, SCB, SYST};
     use cortex_m_rt::{entry, exception};
     use noback::app::Ticker;
-    use noback::board::SampleSource;
-    use noback::digest::Fnv1a;
-    use noback::event_log::{tick_time, Decimal, Event};
-    use noback::monitor::{BrakeState, Scene};
-    use noback::monitor::{Config, Monitor};
-    use noback::platform::{self, meter::Meter, stack};
-    use noback::replay::RECORD_BYTES;
-    use noback::replay::{self, Feeder, StreamRing, Streamed, FEED_CHUNK, HEADER_BYTES};
-    use semihosting::fs::File;
-    use semihosting::io::Read;
-
-    /// Longest trace path the firmware accepts (bytes, without the NUL).
-    const PATH_BYTES: usize = 255;
+    use noback::platform::session::{self, fail, Deadline, Stream};
+    use noback::replay::Streamed;
 
     /// Board clock under QEMU (Hz): lm3s6965evb 12.5 MHz, mps2-an386 25 MHz.
     #[cfg(not(target_abi = "eabihf"))]
@@ -99,179 +88,28 @@ mod target {
         }
     }
 
-    fn fail(what: &str) -> ! {
-        defmt::error!("{=str}", what);
-        platform::exit(noback::exit_code::SELFCHECK_FAILED)
-    }
-
     #[entry]
     fn main() -> ! {
         let Some(peripherals) = cortex_m::Peripherals::take() else {
             fail("peripherals already taken")
         };
-        let mut bench = false;
-        let mut path = [0_u8; PATH_BYTES + 1];
-        if let Ok(args) = semihosting::experimental::env::args::<512>() {
-            for arg in args.flatten() {
-                if arg == "bench" {
-                    bench = true;
-                } else if let Some(p) = arg.strip_prefix("trace=") {
-                    match path.get_mut(..p.len()) {
-                        Some(dst) if p.len() <= PATH_BYTES => dst.copy_from_slice(p.as_bytes()),
-                        _ => fail("the trace path is too long"),
-                    }
-                } else if let Some(n) = arg.strip_prefix("overrun-at=") {
-                    OVERRUN_AT.store(n.parse().unwrap_or(u32::MAX), Ordering::Relaxed);
-                } else if let Some(n) = arg.strip_prefix("reset-every=") {
-                    RESET_EVERY.store(n.parse().unwrap_or(0), Ordering::Relaxed);
-                }
-            }
-        }
-        let report = noback::vectors::run();
-        defmt::info!(
-            "fx-selfcheck cases={=u32} mismatches={=u32} digest={=u32:#010x}",
-            report.cases,
-            report.mismatches,
-            report.digest
-        );
-        let Ok(path) = core::ffi::CStr::from_bytes_until_nul(&path) else {
-            fail("the trace path is not terminated")
-        };
-        let Ok(mut file) = File::open(path) else {
-            fail("cannot open the trace file (pass trace=FILE)")
-        };
-        let mut header = [0_u8; HEADER_BYTES];
-        if file.read_exact(&mut header).is_err() {
-            fail("cannot read the trace header")
-        }
-        let Some(ring) = cortex_m::singleton!(: StreamRing = StreamRing::new()) else {
-            fail("the sample ring is already taken")
-        };
-        let Ok((mut feeder, replay)) = replay::stream(&header, ring) else {
-            fail("the trace is not an NBR1 trace")
-        };
-        feed(&mut feeder, &mut file);
-        let Ok(monitor) = Monitor::new(Config::default()) else {
-            fail("the default monitor configuration was rejected")
-        };
-        defmt::info!(
-            "noback firmware {=str}: {=u32} samples at {=u32} Hz, mode {=str}",
-            env!("CARGO_PKG_VERSION"),
-            replay.len(),
-            replay.tick_hz(),
-            if bench { "bench" } else { "realtime" }
-        );
-        if bench {
-            run_bench(replay, feeder, file, monitor, peripherals.SYST)
+        let args = session::args();
+        OVERRUN_AT.store(args.overrun_at, Ordering::Relaxed);
+        RESET_EVERY.store(args.reset_every, Ordering::Relaxed);
+        session::self_check();
+        let (stream, replay) = session::open(&args);
+        let monitor = session::monitor(&replay, &args, "an evaluation board");
+        if args.bench {
+            session::run_bench(replay, stream, monitor, peripherals.SYST)
         } else {
             let app = Ticker::new(monitor, replay, AlarmPin { high: false });
-            run_realtime(app, feeder, file, peripherals.SYST, peripherals.SCB)
+            run_realtime(app, stream, peripherals.SYST, peripherals.SCB)
         }
-    }
-
-    /// Moves what the ring has room for from the file into it; returns whether it moved any.
-    /// A short or malformed file ends the run (the xtask wrote it: a fault, not a condition).
-    fn feed(feeder: &mut Feeder<'static>, file: &mut File) -> bool {
-        let mut moved = false;
-        loop {
-            let n = feeder.wanted();
-            if n == 0 {
-                return moved;
-            }
-            let mut chunk = [0_u8; FEED_CHUNK * RECORD_BYTES];
-            let Some(buf) = chunk.get_mut(..n * RECORD_BYTES) else {
-                return moved;
-            };
-            if file.read_exact(buf).is_err() {
-                fail("the trace file ended before its header's count")
-            }
-            if feeder.push(buf) != Ok(n) {
-                fail("a trace record has a reserved bit set")
-            }
-            moved = true;
-        }
-    }
-
-    /// Steps the monitor back to back on the replay, measuring each `Monitor::tick` and each
-    /// `Monitor::background` alone (the digest and the logging stay outside the measured
-    /// spans). The digest equals the real-time run's: both fold every estimate's words in order.
-    fn run_bench(
-        mut replay: Streamed<'static>,
-        mut feeder: Feeder<'static>,
-        mut file: File,
-        mut monitor: Monitor,
-        syst: SYST,
-    ) -> ! {
-        let meter = Meter::start(syst);
-        let (a, b) = (meter.now(), meter.now());
-        let overhead = Meter::ticks(a, b);
-        let (mut sum, mut max, mut steps) = (0_u64, 0_u32, 0_u32);
-        let (mut bg_sum, mut bg_max) = (0_u64, 0_u32);
-        // Worst step per recognised scene (Scene as u8: Driving, Holding, FaultBraking,
-        // Overrunning): what each scene's model costs.
-        let mut scene_max = [0_u32; 4];
-        let mut scene_max_at = [0_u32; 4];
-        let mut digest = Fnv1a::new();
-        loop {
-            feed(&mut feeder, &mut file);
-            let Some(inputs) = replay.sample() else {
-                break;
-            };
-            let start = meter.now();
-            let estimate = monitor.tick(&inputs);
-            let ticks = Meter::ticks(start, meter.now()).saturating_sub(overhead);
-            sum += u64::from(ticks);
-            max = max.max(ticks);
-            let start = meter.now();
-            monitor.background();
-            let bg = Meter::ticks(start, meter.now()).saturating_sub(overhead);
-            bg_sum += u64::from(bg);
-            bg_max = bg_max.max(bg);
-            let scene = usize::from(estimate.scene as u8);
-            if let (Some(m), Some(at)) = (scene_max.get_mut(scene), scene_max_at.get_mut(scene)) {
-                if ticks > *m {
-                    *m = ticks;
-                    *at = steps;
-                }
-            }
-            steps += 1;
-            digest.push(noback::app::estimate_checksum(&estimate));
-        }
-        defmt::info!(
-            "bench steps={=u32} ticks_sum={=u64} ticks_max={=u32} bg_ticks_sum={=u64} bg_ticks_max={=u32} overhead={=u32} stack_bytes={=u32} starved={=u32} digest={=u32:#010x}",
-            steps,
-            sum,
-            max,
-            bg_sum,
-            bg_max,
-            overhead,
-            stack::high_water_bytes(),
-            replay.starved(),
-            digest.value()
-        );
-        defmt::info!(
-            "bench-scenes driving={=u32} holding={=u32} fault_braking={=u32} overrunning={=u32} driving_at={=u32} holding_at={=u32} fault_braking_at={=u32} overrunning_at={=u32}",
-            scene_max[0],
-            scene_max[1],
-            scene_max[2],
-            scene_max[3],
-            scene_max_at[0],
-            scene_max_at[1],
-            scene_max_at[2],
-            scene_max_at[3]
-        );
-        platform::exit(noback::exit_code::SUCCESS)
     }
 
     /// SysTick at 10 kHz drives the ticks; the main loop refills the sample ring and logs.
     #[allow(unsafe_code)] // the shared application (`Shared`) and PendSV's priority
-    fn run_realtime(
-        app: App,
-        mut feeder: Feeder<'static>,
-        mut file: File,
-        mut syst: SYST,
-        mut scb: SCB,
-    ) -> ! {
+    fn run_realtime(app: App, mut stream: Stream, mut syst: SYST, mut scb: SCB) -> ! {
         // SAFETY: no interrupt is enabled yet: this is the only context.
         unsafe { *APP.0.get() = Some(app) };
         // SAFETY: PendSV at the lowest priority, so SysTick (priority 0) preempts it; no
@@ -283,12 +121,12 @@ mod target {
         syst.enable_interrupt();
         syst.enable_counter();
         loop {
-            let fed = feed(&mut feeder, &mut file);
+            let fed = stream.feed();
             // SAFETY: inside a critical section neither handler runs.
             let event =
                 critical_section::with(|_| unsafe { shared_app() }.and_then(Ticker::next_event));
             match event {
-                Some(event) => log(&event),
+                Some(event) => session::log(&event),
                 None if DONE.load(Ordering::Acquire) => break,
                 None if fed => {}
                 None => cortex_m::asm::wfi(),
@@ -302,95 +140,15 @@ mod target {
         while BACKGROUND_DUE.load(Ordering::Acquire) {
             core::hint::spin_loop();
         }
+        let deadline = Deadline {
+            isr_max: ISR_TICKS_MAX.load(Ordering::Relaxed),
+            background_max: BACKGROUND_TICKS_MAX.load(Ordering::Relaxed),
+            period: CLOCK_HZ / TICK_HZ,
+        };
         if let Some(app) = unsafe { shared_app() } {
-            finish(app)
+            session::finish(app, &deadline)
         }
         fail("the application state vanished")
-    }
-
-    fn finish(app: &App) -> ! {
-        let t = app.totals();
-        let last = app.last_estimate();
-        defmt::info!(
-            "summary ticks={=u32} overruns={=u32} missed={=u32} starved={=u32} log_overwritten={=u32} alarm_errors={=u32} flags={=u8:#04x} stack_bytes={=u32} isr_ticks_max={=u32} background_ticks_max={=u32} period_ticks={=u32} digest={=u32:#010x}",
-            t.ticks,
-            t.overruns,
-            t.missed_ticks,
-            app.source().starved(),
-            t.log_overwritten,
-            t.alarm_errors,
-            last.map_or(0, |e| e.flags.bits()),
-            stack::high_water_bytes(),
-            ISR_TICKS_MAX.load(Ordering::Relaxed),
-            BACKGROUND_TICKS_MAX.load(Ordering::Relaxed),
-            CLOCK_HZ / TICK_HZ,
-            t.digest
-        );
-        platform::exit(noback::exit_code::SUCCESS)
-    }
-
-    fn scene_name(scene: Scene) -> defmt::Str {
-        match scene {
-            Scene::Driving => defmt::intern!("driving"),
-            Scene::Holding => defmt::intern!("holding"),
-            Scene::FaultBraking => defmt::intern!("fault_braking"),
-            Scene::Overrunning => defmt::intern!("overrunning"),
-        }
-    }
-
-    fn brake_name(brake: BrakeState) -> defmt::Str {
-        match brake {
-            BrakeState::Released => defmt::intern!("released"),
-            BrakeState::Slipping => defmt::intern!("slipping"),
-            BrakeState::Locked => defmt::intern!("locked"),
-        }
-    }
-
-    /// One log line per event, in engineering units: `t` is the time of the sample the tick
-    /// stepped on (the trace's time base), forces in N, torques in N·m as magnitudes (the
-    /// trace's convention), flags as bits.
-    fn log(event: &Event) {
-        match *event {
-            Event::State {
-                tick,
-                scene,
-                brake,
-                pressing_force_bits,
-                braking_torque_bits,
-                flags,
-            } => {
-                let (s, frac) = tick_time(tick);
-                let force = Decimal::from_q16(pressing_force_bits, 10);
-                let torque = Decimal::from_q16(braking_torque_bits.saturating_abs(), 100);
-                defmt::info!(
-                    "state t={=u32}.{=u32:04} s scene={=istr} brake={=istr} force={=str}{=u32}.{=u32:01} N torque={=u32}.{=u32:02} Nm flags={=u8:#04x}",
-                    s,
-                    frac,
-                    scene_name(scene),
-                    brake_name(brake),
-                    force.sign(),
-                    force.whole,
-                    force.frac,
-                    torque.whole,
-                    torque.frac,
-                    flags.bits()
-                )
-            }
-            Event::FlagsChanged { tick, before, now } => {
-                let (s, frac) = tick_time(tick);
-                defmt::warn!(
-                    "flags t={=u32}.{=u32:04} s tick={=u32} before={=u8:#04x} now={=u8:#04x}",
-                    s,
-                    frac,
-                    tick,
-                    before.bits(),
-                    now.bits()
-                )
-            }
-            Event::Overrun { tick, missed } => {
-                defmt::warn!("overrun tick={=u32} missed={=u32}", tick, missed)
-            }
-        }
     }
 
     #[exception]

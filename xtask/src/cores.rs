@@ -5,6 +5,18 @@
 //! mps2-an386, which has the FPU. The M7 (mps2-an500) runs the M4F's image: same target, so
 //! the cargo runner's tests (which pick the core from the target) run on the M4F only.
 
+/// The STM32F405 board crate's manifest (its own workspace).
+pub const BOARD_MANIFEST: &str = "boards/stm32f405/Cargo.toml";
+
+/// Where a firmware image is built from.
+#[derive(Clone, Copy, Debug)]
+pub enum Firmware {
+    /// A package of the root workspace (`-p`).
+    Package(&'static str),
+    /// A crate with a workspace of its own (`--manifest-path`, relative to the root).
+    Manifest(&'static str),
+}
+
 /// A core under test.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Core {
@@ -16,6 +28,9 @@ pub enum Core {
     M4f,
     /// Cortex-M7 with FPU (ARMv7E-M, hard float): mps2-an500, the M4F's image.
     M7,
+    /// Cortex-M4F in a real part, an STM32F405: netduinoplus2 booting the board crate's image
+    /// (`boards/stm32f405`, chosen by `--board stm32f405`, not `--core`).
+    Stm32f405,
 }
 
 impl Core {
@@ -31,6 +46,7 @@ impl Core {
             Core::M3 => "m3",
             Core::M4f => "m4f",
             Core::M7 => "m7",
+            Core::Stm32f405 => "stm32f405",
         }
     }
 
@@ -39,7 +55,7 @@ impl Core {
         match self {
             Core::M0 => "thumbv6m-none-eabi",
             Core::M3 => "thumbv7m-none-eabi",
-            Core::M4f | Core::M7 => "thumbv7em-none-eabihf",
+            Core::M4f | Core::M7 | Core::Stm32f405 => "thumbv7em-none-eabihf",
         }
     }
 
@@ -50,6 +66,7 @@ impl Core {
             Core::M3 => ("lm3s6965evb", "cortex-m3"),
             Core::M4f => ("mps2-an386", "cortex-m4"),
             Core::M7 => ("mps2-an500", "cortex-m7"),
+            Core::Stm32f405 => ("netduinoplus2", "cortex-m4"),
         }
     }
 
@@ -59,6 +76,26 @@ impl Core {
         match self {
             Core::M0 | Core::M3 => 12.5e6,
             Core::M4f | Core::M7 => 25.0e6,
+            // QEMU's netduinoplus2 runs the core at the part's 168 MHz.
+            Core::Stm32f405 => 168.0e6,
+        }
+    }
+
+    /// The manifest (a workspace of its own for a board crate, else the root's package) and
+    /// binary of the firmware image this core boots.
+    pub fn firmware(self) -> (Firmware, &'static str) {
+        match self {
+            Core::Stm32f405 => (Firmware::Manifest(BOARD_MANIFEST), "noback-stm32f405"),
+            _ => (Firmware::Package("noback"), "noback-fw"),
+        }
+    }
+
+    /// The core's clock in flight (Hz), for the share of the deadline a tick takes: the
+    /// STM32F405's 168 MHz, else the 100 MHz reference of the cost line.
+    pub fn flight_clock_hz(self) -> f64 {
+        match self {
+            Core::Stm32f405 => 168.0e6,
+            _ => 100.0e6,
         }
     }
 

@@ -5,6 +5,8 @@
 //! dispatches. The README's two commands are `cargo xtask run` and `cargo xtask test`.
 
 mod bench;
+mod board_pin;
+mod board_test;
 mod bootstrap;
 mod cores;
 mod defmt_log;
@@ -110,6 +112,13 @@ struct TwinBenchArgs {
 /// A clap value parser: a core name.
 pub fn core_arg(s: &str) -> Result<Core, String> {
     Core::parse(s).map_err(|_| "expected m0, m3, m4f or m7".into())
+}
+
+/// Parses `--board` (the real parts with a board crate: `stm32f405`).
+pub fn board_arg(s: &str) -> Result<Core, String> {
+    (s == Core::Stm32f405.name())
+        .then_some(Core::Stm32f405)
+        .ok_or_else(|| "expected stm32f405".into())
 }
 
 /// Every command's name (the tidy test checks the README and docs name only these).

@@ -48,7 +48,7 @@ pub fn main() -> Result<i32, String> {
             )?;
             let flash = elf_size::of_file(&elf)?.flash_bytes;
             let args = vec!["bench".into(), format!("trace={}", replay.display())];
-            let out = run::boot(core, &elf, BENCH_SHIFT, args, false)?;
+            let out = run::boot(core, &elf, BENCH_SHIFT, args, false, &[])?;
             let line = run::line_with(&out.lines, "bench")?;
             let (mean, max) = run::step_insns(&line, core)?;
             if core == Core::M3 && m3_best.is_none_or(|(_, best)| mean < best) {

@@ -8,7 +8,7 @@
 //! overruns, flags with times, estimate against the twin at key moments, instructions per step,
 //! flash, RAM, stack, and whether the firmware's estimates equal the host's bit for bit.
 
-use crate::cores::Core;
+use crate::cores::{Core, Firmware};
 use crate::qemu::BOOT_TIMEOUT;
 use crate::qemu::{self, Boot, Outcome};
 use crate::replay::{host_run, nbr1, stress_trace, twin_trace, STRESS};
@@ -23,6 +23,8 @@ pub const STRESS_RESET_EVERY: u32 = 50;
 
 /// Real-time boot: 2^4 ns = 16 ns per instruction.
 pub const REALTIME_SHIFT: u32 = 4;
+/// The monitor's tick rate (Hz).
+const TICK_HZ: f64 = 10_000.0;
 /// Bench boot: 2^10 ns per instruction, 12.8 (M0/M3) or 25.6 (M4F) SysTick ticks each.
 pub const BENCH_SHIFT: u32 = 10;
 
@@ -35,6 +37,10 @@ pub struct RunArgs {
     /// The emulated core.
     #[arg(long, value_parser = crate::core_arg, default_value = "m3", value_name = "m0|m3|m4f|m7")]
     pub core: Core,
+    /// A real part instead of an evaluation board: `stm32f405` boots the board crate's image
+    /// (stm32f4xx-hal, RTIC) on QEMU's netduinoplus2; it overrides `--core`.
+    #[arg(long, value_parser = crate::board_arg, value_name = "stm32f405")]
+    pub board: Option<Core>,
     /// Print the summary as one JSON object.
     #[arg(long)]
     pub json: bool,
@@ -109,7 +115,8 @@ pub fn main(a: &RunArgs) -> Result<i32, String> {
     }
     bootstrap::ensure_all()?;
     let reset_every = (a.scene == STRESS).then_some(STRESS_RESET_EVERY);
-    let (report, ok) = match replay_report(&a.scene, a.core, a.overrun_at, reset_every, !a.json) {
+    let core = a.board.unwrap_or(a.core);
+    let (report, ok) = match replay_report(&a.scene, core, a.overrun_at, reset_every, !a.json) {
         // The twin failing on a scene that passed the schema is still the scene's fault.
         Err(e) if e.starts_with("twin: ") => return Ok(noback_twin::args::bad_input("run", &e)),
         other => other?,
@@ -165,13 +172,21 @@ pub fn replay_report(
     if let Some(n) = reset_every {
         rt_args.push(format!("reset-every={n}"));
     }
-    let realtime = boot(core, &elf, REALTIME_SHIFT, rt_args, echo)?;
+    // The board's GPIO is read back from QEMU's log of its (unmodelled) registers.
+    let gpio_log = dir.join(format!("{stem}-{}-gpio.log", core.name()));
+    let rt_extra = if core == Core::Stm32f405 {
+        crate::board_pin::qemu_flags(&gpio_log)
+    } else {
+        Vec::new()
+    };
+    let realtime = boot(core, &elf, REALTIME_SHIFT, rt_args, echo, &rt_extra)?;
     let bench = boot(
         core,
         &elf,
         BENCH_SHIFT,
         vec!["bench".into(), trace_arg],
         false,
+        &[],
     )?;
 
     let summary = line_with(&realtime.lines, "summary")?;
@@ -255,6 +270,24 @@ pub fn replay_report(
         })
         .collect();
 
+    let isr_insns_max = (isr_ticks_max / core.ticks_per_insn(REALTIME_SHIFT)).round();
+    let (alarm_pin, alarm_ok) = if core == Core::Stm32f405 {
+        let log = std::fs::read_to_string(&gpio_log)
+            .map_err(|e| format!("{}: {e}", gpio_log.display()))?;
+        let first_flag = flags
+            .first()
+            .and_then(|f| f["tick"].as_u64())
+            .map(|t| t as u32);
+        crate::board_pin::report(
+            &crate::board_pin::levels(&log)?,
+            ticks,
+            &overruns,
+            first_flag,
+        )
+    } else {
+        (serde_json::Value::Null, true)
+    };
+    let flight_hz = core.flight_clock_hz();
     let report = json!({
         "scene": scene,
         "core": core.name(),
@@ -271,7 +304,10 @@ pub fn replay_report(
         "background_insns_per_call_mean": (bg_mean * 10.0).round() / 10.0,
         "background_insns_per_call_max": bg_max.round(),
         "cpu_share_pct_at_100mhz": (insns_mean + bg_mean).round() / 100.0,
-        "isr_insns_max": (isr_ticks_max / core.ticks_per_insn(REALTIME_SHIFT)).round(),
+        "isr_insns_max": isr_insns_max,
+        "flight_clock_mhz": flight_hz / 1e6,
+        "isr_deadline_pct_at_flight_clock": (1e5 * isr_insns_max * TICK_HZ / flight_hz).round() / 1e3,
+        "alarm_pin": alarm_pin,
         "deadline_used_pct": (1000.0 * isr_ticks_max / period_ticks).round() / 10.0,
         "deadline_used_with_background_pct": (1000.0 * background_ticks_max / period_ticks).round() / 10.0,
         "flash_bytes": flash_bytes,
@@ -284,7 +320,7 @@ pub fn replay_report(
         "host_digest": format!("{:#010x}", host.totals.digest),
         "key_moments": moments,
     });
-    let ok = realtime.code == 0 && bench.code == 0 && bit_exact && starved == 0;
+    let ok = realtime.code == 0 && bench.code == 0 && bit_exact && starved == 0 && alarm_ok;
     Ok((report, ok))
 }
 
@@ -346,7 +382,22 @@ fn print_summary(r: &serde_json::Value) {
 /// Builds the firmware for `core` in release; returns the ELF path. It streams its trace from
 /// the file named by its `trace=FILE` argument.
 pub fn build(core: Core) -> Result<String, String> {
-    build_bin("noback-fw", core, None, &[])
+    match core.firmware() {
+        (Firmware::Package(package), bin) => build_package_bin(package, bin, core, None, &[]),
+        (Firmware::Manifest(manifest), bin) => {
+            let dir = workspace_root().join("target");
+            let manifest = workspace_root().join(manifest);
+            shell::run(
+                cargo()
+                    .args(["build", "--release", "--bin", bin, "--manifest-path"])
+                    .arg(&manifest)
+                    .args(["--target", core.triple(), "--target-dir"])
+                    .arg(&dir),
+            )?;
+            let elf = dir.join(core.triple()).join("release").join(bin);
+            Ok(elf.to_string_lossy().into_owned())
+        }
+    }
 }
 
 /// Builds a target binary of the `noback` package in release for `core` (into `target_dir`,
@@ -411,8 +462,10 @@ pub fn boot(
     shift: u32,
     args: Vec<String>,
     echo: bool,
+    more: &[String],
 ) -> Result<Outcome, String> {
-    let extra = qemu::icount(shift);
+    let mut extra = qemu::icount(shift);
+    extra.extend_from_slice(more);
     if echo {
         println!(
             "$ {}",

@@ -136,7 +136,7 @@ pub fn main(a: &TestArgs) -> Result<i32, String> {
         if core == Core::M3 {
             snapshot::check(&report, bless)?;
             section("provoked overrun (m3)");
-            overrun_is_counted_and_flagged()?;
+            overrun_is_counted_and_flagged(Core::M3)?;
             section("load: hostile inputs, flags reset every 50 ticks (m3)");
             stress_stays_within_its_deadline()?;
             section("one time base: a flag's time from run equals monitor's (m3)");
@@ -153,6 +153,10 @@ pub fn main(a: &TestArgs) -> Result<i32, String> {
         rows.push((core, test_digest, fw_digest));
     }
 
+    if a.core.is_empty() {
+        rows.push((Core::Stm32f405, None, crate::board_test::stage()?));
+    }
+
     section("bit-identity of the fixed-point vectors");
     println!("host digest {host_digest:#010x}");
     let mut identical = true;
@@ -161,7 +165,7 @@ pub fn main(a: &TestArgs) -> Result<i32, String> {
         identical &= ok;
         let test = test_digest.map_or("—         ".to_string(), |d| format!("{d:#010x}"));
         println!(
-            "{:<4} test {test}  firmware {fw_digest:#010x}  {}",
+            "{:<9} test {test}  firmware {fw_digest:#010x}  {}",
             core.name(),
             if ok { "identical" } else { "DIFFERENT" }
         );
@@ -219,10 +223,10 @@ fn target_tests(core: Core) -> Result<Vec<String>, String> {
 /// Tick at which the overrun test makes the interrupt miss its deadline.
 const OVERRUN_TICK: u32 = 3000;
 
-/// Provokes one missed deadline and checks it is counted, flagged and replayed identically.
-fn overrun_is_counted_and_flagged() -> Result<(), String> {
-    let (report, ok) =
-        run::replay_report(SNAPSHOT_SCENE, Core::M3, Some(OVERRUN_TICK), None, false)?;
+/// Provokes one missed deadline on `core` and checks it is counted, flagged and replayed
+/// identically; returns the run's report.
+pub fn overrun_is_counted_and_flagged(core: Core) -> Result<serde_json::Value, String> {
+    let (report, ok) = run::replay_report(SNAPSHOT_SCENE, core, Some(OVERRUN_TICK), None, false)?;
     let overruns = report["overruns"].as_u64().unwrap_or(0);
     let flagged = report["flags"]
         .as_array()
@@ -240,7 +244,7 @@ fn overrun_is_counted_and_flagged() -> Result<(), String> {
     let missed = report["missed_ticks"].as_u64();
     let flag_in_time = flagged == Some(u64::from(OVERRUN_TICK) + 4);
     if overruns == 1 && missed == Some(2) && flag_in_time && ok {
-        Ok(())
+        Ok(report)
     } else {
         Err("the provoked overrun was not counted once (two ticks missed), flagged on the next stepped tick and replayed bit-exactly".into())
     }
@@ -289,12 +293,7 @@ fn stress_stays_within_its_deadline() -> Result<(), String> {
 /// A fault scene through the firmware and through `monitor`'s comparison on the host: each flag
 /// must carry the same time (the trace's sample time) in both reports.
 fn run_and_monitor_agree_on_time() -> Result<(), String> {
-    let dir = crate::shell::workspace_root().join("target").join("replay");
-    std::fs::create_dir_all(&dir).map_err(|e| e.to_string())?;
-    let scene = dir.join("time_base.toml");
-    let text = "[scene]\nkind = \"reverse_load\"\n[[fault]]\nkind = \"encoder_stuck\"\nat_s = 0.1\nseverity = 1.0\n";
-    std::fs::write(&scene, text).map_err(|e| e.to_string())?;
-    let scene = scene.to_string_lossy().into_owned();
+    let scene = fault_scene()?;
     let (report, ok) = run::replay_report(&scene, Core::M3, None, None, false)?;
     let trace = crate::replay::twin_trace(&scene)?;
     let estimates = host_tests::accuracy::run_monitor(&trace, noback::monitor::Config::default())?;
@@ -327,6 +326,17 @@ fn run_and_monitor_agree_on_time() -> Result<(), String> {
     } else {
         Err("run and monitor report different flags or times on the same scene".into())
     }
+}
+
+/// Writes the fault scene of the time-base and alarm-pin tests (an encoder sticking at 0.1 s
+/// during reverse-load braking); returns its path.
+pub fn fault_scene() -> Result<String, String> {
+    let dir = crate::shell::workspace_root().join("target").join("replay");
+    std::fs::create_dir_all(&dir).map_err(|e| e.to_string())?;
+    let scene = dir.join("time_base.toml");
+    let text = "[scene]\nkind = \"reverse_load\"\n[[fault]]\nkind = \"encoder_stuck\"\nat_s = 0.1\nseverity = 1.0\n";
+    std::fs::write(&scene, text).map_err(|e| e.to_string())?;
+    Ok(scene.to_string_lossy().into_owned())
 }
 
 /// Boots the three fault probes and checks each ends with its own non-zero exit code.

@@ -1,0 +1,52 @@
+//! Where samples come from and where the log goes, per build: under QEMU the shared session
+//! (trace streamed from the host, defmt over semihosting); on a part the board's sensors and
+//! defmt over RTT.
+
+use crate::app::App;
+
+/// The tick's sample source under QEMU: the twin's trace, streamed from the host.
+#[cfg(feature = "qemu")]
+pub type Source = noback::replay::Streamed<'static>;
+#[cfg(feature = "qemu")]
+pub use noback::platform::session::{log, Stream};
+
+/// The `summary` line and the exit, at the trace's end.
+#[cfg(feature = "qemu")]
+pub fn finish(app: &App, isr_max: u32, background_max: u32) -> ! {
+    let deadline = noback::platform::session::Deadline {
+        isr_max,
+        background_max,
+        period: crate::clock::SYSTICK_PER_TICK,
+    };
+    noback::platform::session::finish(app, &deadline)
+}
+
+/// The tick's sample source on a part: ADC and encoder timers.
+#[cfg(feature = "hw")]
+pub type Source = crate::sensors::Sensors;
+
+/// On a part nothing streams in: the idle loop only drains the log.
+#[cfg(feature = "hw")]
+pub struct Stream;
+
+#[cfg(feature = "hw")]
+impl Stream {
+    /// Nothing to feed.
+    pub fn feed(&mut self) -> bool {
+        false
+    }
+}
+
+/// One defmt line per event, over RTT.
+#[cfg(feature = "hw")]
+pub fn log(event: &noback::event_log::Event) {
+    defmt::info!("{}", defmt::Debug2Format(event));
+}
+
+/// A part's sensors never run out, so this is never reached; it parks the core.
+#[cfg(feature = "hw")]
+pub fn finish(_app: &App, _isr_max: u32, _background_max: u32) -> ! {
+    loop {
+        cortex_m::asm::wfi();
+    }
+}

@@ -1,0 +1,231 @@
+//! The noback firmware on an STM32F405 (Cortex-M4F, 168 MHz), through `stm32f4xx-hal` and
+//! RTIC: TIM3's update interrupt paces the 10 kHz tick (priority 2), the monitor's slow lane
+//! runs as a priority-1 task before the next tick, and the idle loop feeds and logs.
+//!
+//! | build | samples from | log | clocks |
+//! |---|---|---|---|
+//! | `qemu` (default; QEMU `netduinoplus2`) | the host's twin trace over semihosting | defmt over semihosting | RCC left at reset (QEMU does not model it) |
+//! | `hw` (a real part, probe-rs) | ADC1 and the timers' encoder modes ([`sensors`]) | defmt over RTT | 8 MHz HSE → 168 MHz |
+//!
+//! The alarm is PA10 (the Netduino Plus 2's user LED) through the HAL's `OutputPin`. Under
+//! QEMU the `bench` argument counts instructions as the evaluation boards' image does.
+#![cfg_attr(target_os = "none", no_std, no_main)]
+
+#[cfg(all(target_os = "none", feature = "qemu", feature = "hw"))]
+compile_error!("choose one build: `qemu` (the default) or `hw` (--no-default-features)");
+
+#[cfg(all(target_os = "none", feature = "hw"))]
+mod sensors;
+// On a part: defmt frames over RTT, panics reported to the probe.
+#[cfg(all(target_os = "none", feature = "hw"))]
+use {defmt_rtt as _, panic_probe as _};
+
+#[cfg(target_os = "none")]
+mod clock;
+#[cfg(target_os = "none")]
+mod io;
+
+/// The application: RTIC's generated code needs `unsafe` for its resource cells.
+#[cfg(target_os = "none")]
+#[allow(unsafe_code, missing_docs)]
+#[rtic::app(device = stm32f4xx_hal::pac, dispatchers = [USART6])]
+mod app {
+    use crate::clock::{self, TIMER_HZ};
+    use cortex_m::peripheral::SYST;
+    use fugit::TimerDurationU32;
+    use noback::app::Ticker;
+    use stm32f4xx_hal::gpio::{Output, PA10};
+    use stm32f4xx_hal::pac;
+    use stm32f4xx_hal::prelude::*;
+    use stm32f4xx_hal::timer::{Counter, Event, Flag};
+
+    use crate::io::{self, Stream};
+    #[cfg(feature = "qemu")]
+    use noback::platform::session;
+
+    /// The application: the monitor's tick with its sample source and alarm pin.
+    pub type App = Ticker<io::Source, PA10<Output>>;
+
+    #[shared]
+    struct Shared {
+        app: App,
+        timer: Counter<pac::TIM3, TIMER_HZ>,
+        /// The last tick's slow-lane work has not finished yet.
+        background_due: bool,
+        /// The source has run out (end of a replayed trace).
+        done: bool,
+        /// SysTick at the tick handler's entry.
+        tick_entry: u32,
+        /// Most SysTick counts from a tick handler's entry to its end / its background's end.
+        isr_max: u32,
+        background_max: u32,
+    }
+
+    #[local]
+    struct Local {
+        stream: Stream,
+        /// Ticks elapsed to report on the next tick (2 after a missed deadline).
+        elapsed: u8,
+        tick_no: u32,
+        overrun_at: u32,
+        reset_every: u32,
+    }
+
+    #[init]
+    fn init(cx: init::Context) -> (Shared, Local) {
+        let dp = cx.device;
+        let mut rcc = clock::setup(dp.RCC);
+        #[cfg(feature = "qemu")]
+        let (args, stream, source, monitor) = {
+            let args = session::args();
+            session::self_check();
+            let (stream, replay) = session::open(&args);
+            let monitor = session::monitor(&replay, &args, "STM32F405");
+            if args.bench {
+                session::run_bench(replay, stream, monitor, cx.core.SYST)
+            }
+            (args, stream, replay, monitor)
+        };
+        let gpioa = dp.GPIOA.split(&mut rcc);
+        #[cfg(feature = "hw")]
+        let (stream, source, monitor) = {
+            let gpiob = dp.GPIOB.split(&mut rcc);
+            let wiring = crate::sensors::Wiring {
+                adc: (dp.ADC1, gpioa.pa3),
+                motor: (dp.TIM4, gpiob.pb6, gpiob.pb7),
+                output: (dp.TIM5, gpioa.pa0, gpioa.pa1),
+                drive: gpiob.pb0,
+            };
+            crate::sensors::setup(&mut rcc, wiring)
+        };
+        let app = Ticker::new(monitor, source, gpioa.pa10.into_push_pull_output());
+        // SysTick runs free on the core clock: the meter of each tick's time used.
+        clock::start_meter(cx.core.SYST);
+        let mut timer = dp.TIM3.counter::<TIMER_HZ>(&mut rcc);
+        if timer
+            .start(TimerDurationU32::from_ticks(clock::PERIOD_COUNTS))
+            .is_err()
+        {
+            clock::halt("TIM3 rejected the tick period")
+        }
+        timer.listen(Event::Update);
+        (
+            Shared {
+                app,
+                timer,
+                background_due: false,
+                done: false,
+                tick_entry: 0,
+                isr_max: 0,
+                background_max: 0,
+            },
+            Local {
+                stream,
+                elapsed: 1,
+                tick_no: 0,
+                #[cfg(feature = "qemu")]
+                overrun_at: args.overrun_at,
+                #[cfg(feature = "qemu")]
+                reset_every: args.reset_every,
+                #[cfg(feature = "hw")]
+                overrun_at: u32::MAX,
+                #[cfg(feature = "hw")]
+                reset_every: 0,
+            },
+        )
+    }
+
+    /// Feeds the sample ring (under QEMU) and prints the log; at a trace's end, the summary.
+    #[idle(shared = [app, timer, done, isr_max, background_max, background_due], local = [stream])]
+    fn idle(mut cx: idle::Context) -> ! {
+        loop {
+            let fed = cx.local.stream.feed();
+            match cx.shared.app.lock(|app| app.next_event()) {
+                Some(event) => io::log(&event),
+                None if cx.shared.done.lock(|d| *d) => break,
+                None if fed => {}
+                None => cortex_m::asm::wfi(),
+            }
+        }
+        cx.shared.timer.lock(|t| t.unlisten(Event::Update));
+        while cx.shared.background_due.lock(|d| *d) {
+            core::hint::spin_loop();
+        }
+        let isr_max = cx.shared.isr_max.lock(|m| *m);
+        let background_max = cx.shared.background_max.lock(|m| *m);
+        cx.shared
+            .app
+            .lock(|app| io::finish(app, isr_max, background_max))
+    }
+
+    /// The 10 kHz tick: skipped (counted) while the last background work is unfinished.
+    #[task(binds = TIM3, priority = 2, shared = [app, timer, background_due, done, tick_entry, isr_max], local = [elapsed, tick_no, overrun_at, reset_every])]
+    fn tick(cx: tick::Context) {
+        let entry = SYST::get_current();
+        let tick::SharedResources {
+            mut app,
+            mut timer,
+            mut background_due,
+            mut done,
+            mut tick_entry,
+            mut isr_max,
+            ..
+        } = cx.shared;
+        tick_entry.lock(|e| *e = entry);
+        timer.lock(|t| t.clear_flags(Flag::Update));
+        let n = *cx.local.elapsed;
+        if background_due.lock(|d| *d) {
+            *cx.local.elapsed = n.saturating_add(1);
+            return;
+        }
+        *cx.local.elapsed = 1;
+        let tick_no = *cx.local.tick_no;
+        *cx.local.tick_no = tick_no.wrapping_add(1);
+        let reset_every = *cx.local.reset_every;
+        let stepped = app.lock(|app| {
+            let estimate = app.tick(n);
+            if reset_every != 0 && tick_no.wrapping_add(1).is_multiple_of(reset_every) {
+                app.reset_flags();
+            }
+            estimate.is_some()
+        });
+        if stepped && background::spawn().is_ok() {
+            background_due.lock(|d| *d = true);
+        } else if !stepped {
+            done.lock(|d| *d = true);
+        }
+        timer.lock(|t| {
+            if tick_no == *cx.local.overrun_at {
+                // Provoked overrun: run on until the next tick is due, then half a period more.
+                while !t.flags().contains(Flag::Update) {}
+                while t.now().ticks() % clock::PERIOD_COUNTS < clock::PERIOD_COUNTS / 2 {}
+            }
+            // The next update already flagged means this handler ran past its deadline.
+            if t.flags().contains(Flag::Update) {
+                *cx.local.elapsed = 2;
+            } else {
+                let used = clock::counts(entry, SYST::get_current());
+                isr_max.lock(|m| *m = (*m).max(used));
+            }
+        });
+    }
+
+    /// The monitor's slow-lane work for the last tick.
+    #[task(priority = 1, shared = [app, timer, background_due, tick_entry, background_max])]
+    async fn background(mut cx: background::Context) {
+        cx.shared.app.lock(|app| app.background());
+        let entry = cx.shared.tick_entry.lock(|e| *e);
+        let used = clock::counts(entry, SYST::get_current());
+        let late = cx.shared.timer.lock(|t| t.flags().contains(Flag::Update));
+        if !late {
+            cx.shared.background_max.lock(|m| *m = (*m).max(used));
+        }
+        cx.shared.background_due.lock(|d| *d = false);
+    }
+}
+
+/// On the host this binary only says where it runs.
+#[cfg(not(target_os = "none"))]
+fn main() {
+    println!("noback-stm32f405 runs on an STM32F405: `cargo xtask run --board stm32f405` boots it under QEMU");
+}
