@@ -448,7 +448,11 @@ impl State {
         Estimate {
             tick: self.tick,
             friction_energy_j: self.energy.joules,
-            trusted: self.load.estimate.known().is_some() && o.settled && o.sensors_ok && o.in_time,
+            trusted: self.load.estimate.known().is_some()
+                && o.settled
+                && o.sensors_ok
+                && o.in_time
+                && !self.flags.fault(),
             flags: self.flags,
             ..self.estimate
         }

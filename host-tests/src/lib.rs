@@ -6,6 +6,7 @@
 //! monitor and the twin, which know nothing of each other.
 
 pub mod accuracy;
+pub mod family;
 pub mod fuzz;
 pub mod mc;
 pub mod robustness;

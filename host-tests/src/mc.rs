@@ -15,6 +15,7 @@
 //! alarm. Runs are spread over the machine's cores.
 
 use crate::accuracy::{compare, detection_latency_s, manifest_time, run_monitor, scene_trace};
+use crate::family::Family;
 use noback::mechanism::Mechanism;
 use noback::monitor::Config;
 use noback_twin::fault::{Fault, FaultKind};
@@ -183,7 +184,18 @@ fn stream(fault: Option<FaultKind>) -> u64 {
 
 /// Draws run `index` of a campaign: deterministic in (`seed`, `index`, `fault`).
 pub fn draw(seed: u64, index: u64, fault: Option<FaultKind>) -> Draw {
-    draw_from(&SCENE_KINDS, run_rng(seed, index, fault), index, fault)
+    draw_in(Family::PhysicalDefault, seed, index, fault)
+}
+
+/// [`draw`] from a plant family: the default family's draws, then the plant's form
+/// ([`crate::family::draw_form`]) from the same stream.
+pub fn draw_in(family: Family, seed: u64, index: u64, fault: Option<FaultKind>) -> Draw {
+    let mut rng = run_rng(seed, index, fault);
+    let mut d = draw_from(&SCENE_KINDS, &mut rng, index, fault);
+    if family == Family::Plant {
+        crate::family::draw_form(&mut d.scene, &mut rng);
+    }
+    d
 }
 
 /// A draw of the campaigns before issue 21, whose generator started at
@@ -191,8 +203,9 @@ pub fn draw(seed: u64, index: u64, fault: Option<FaultKind>) -> Draw {
 /// among `kinds` (before continuous closing joined: `&SCENE_KINDS[..4]`). The tests and
 /// measurements that name a run of those campaigns reproduce it with this.
 pub fn draw_among(kinds: &[SceneKind], seed: u64, index: u64, fault: Option<FaultKind>) -> Draw {
-    let rng = Rng::new(seed ^ index.wrapping_mul(0x9E37_79B9_7F4A_7C15) ^ (stream(fault) << 56));
-    draw_from(kinds, rng, index, fault)
+    let mut rng =
+        Rng::new(seed ^ index.wrapping_mul(0x9E37_79B9_7F4A_7C15) ^ (stream(fault) << 56));
+    draw_from(kinds, &mut rng, index, fault)
 }
 
 /// [`draw_among`] the five scene kinds: run `index` of a campaign before issue 21.
@@ -200,7 +213,7 @@ pub fn draw_legacy(seed: u64, index: u64, fault: Option<FaultKind>) -> Draw {
     draw_among(&SCENE_KINDS, seed, index, fault)
 }
 
-fn draw_from(kinds: &[SceneKind], mut rng: Rng, index: u64, fault: Option<FaultKind>) -> Draw {
+fn draw_from(kinds: &[SceneKind], rng: &mut Rng, index: u64, fault: Option<FaultKind>) -> Draw {
     let kind = kinds
         .get((rng.next_u64() % kinds.len().max(1) as u64) as usize)
         .copied()
@@ -214,7 +227,7 @@ fn draw_from(kinds: &[SceneKind], mut rng: Rng, index: u64, fault: Option<FaultK
     if let Some(release) = scene.release_at_s.as_mut() {
         *release = 0.1 + 0.2 * rng.uniform();
     }
-    scale_all(&mut scene.mechanism, &mut rng);
+    scale_all(&mut scene.mechanism, rng);
     scene.noise.seed = rng.next_u64();
     scene.noise.current_noise_a = 0.1 * rng.uniform();
     if let Some(kind) = fault {

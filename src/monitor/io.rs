@@ -163,6 +163,12 @@ impl Flags {
         self.bits() != 0
     }
 
+    /// Whether a brake or sensor fault is raised (every flag but `overrun`, which says a tick
+    /// was missed, not that the plant or a sensor is other than the model).
+    pub const fn fault(self) -> bool {
+        self.bits() & 0b1111 != 0
+    }
+
     /// Flags raised in `self` or `other`.
     #[inline]
     pub const fn union(self, other: Flags) -> Flags {
@@ -211,7 +217,8 @@ pub struct Estimate {
     pub pack_health: Q16,
     /// Friction energy dissipated in the pack since power-on (J).
     pub friction_energy_j: U40F24,
-    /// Whether the estimate can be relied on (load known, observer settled, sensors plausible).
+    /// Whether the estimate can be relied on (load known, observer settled, sensors plausible,
+    /// no brake or sensor fault latched: a faulty plant is not the model the estimate assumes).
     pub trusted: bool,
     /// Latched failure flags.
     pub flags: Flags,

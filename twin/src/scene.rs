@@ -77,6 +77,10 @@ pub struct Noise {
     pub seed: u64,
     /// Standard deviation of the current-measurement noise (A); 0 = noiseless.
     pub current_noise_a: f64,
+    /// Current sensor's gain: measured = gain × true + offset (+ noise); 1 = ideal.
+    pub current_gain: f64,
+    /// Current sensor's offset (A); 0 = ideal.
+    pub current_offset_a: f64,
 }
 
 /// A complete scene.
@@ -134,6 +138,8 @@ impl Scene {
             noise: Noise {
                 seed: 1,
                 current_noise_a: 0.0,
+                current_gain: 1.0,
+                current_offset_a: 0.0,
             },
             open: DEFAULT_OPEN,
             faults: Vec::new(),

@@ -122,6 +122,8 @@ struct RawSensors {
     motor_counter_bits: Option<u8>,
     noise_seed: Option<u64>,
     current_noise_a: Option<f64>,
+    current_gain: Option<f64>,
+    current_offset_a: Option<f64>,
 }
 
 #[derive(Deserialize, Default)]
@@ -386,6 +388,20 @@ impl RawFile {
             "sensors.current_noise_a",
             0.0,
             100.0,
+        )?;
+        ranged(
+            &mut s.noise.current_gain,
+            rs.current_gain,
+            "sensors.current_gain",
+            0.5,
+            1.5,
+        )?;
+        ranged(
+            &mut s.noise.current_offset_a,
+            rs.current_offset_a,
+            "sensors.current_offset_a",
+            -5.0,
+            5.0,
         )?;
         let ro = self.open;
         let o = &mut s.open;

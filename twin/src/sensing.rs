@@ -68,7 +68,8 @@ pub fn trace(
     let rows = samples
         .iter()
         .map(|s| {
-            let mut current = sensors.current_for_torque_a(s.drive_torque_nm);
+            let mut current = noise.current_gain * sensors.current_for_torque_a(s.drive_torque_nm)
+                + noise.current_offset_a;
             if noise.current_noise_a > 0.0 {
                 current += noise.current_noise_a * rng.normal();
             }

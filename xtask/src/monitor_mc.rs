@@ -10,7 +10,8 @@ mod throughput;
 
 use crate::shell::workspace_root;
 use clap::{Args, Parser, Subcommand};
-use host_tests::mc::{draw, draw_legacy, run_all, Campaign as Setup, FAULT_KINDS, PLANT_FAMILY};
+use host_tests::family::Family;
+use host_tests::mc::{draw_in, draw_legacy, run_all, Campaign as Setup, Draw, FAULT_KINDS};
 use part::{Campaign, Part};
 use std::io::Write as _;
 use std::path::{Path, PathBuf};
@@ -78,6 +79,15 @@ struct RunArgs {
     /// Worker threads (default: the machine's cores).
     #[arg(long, value_parser = clap::value_parser!(u64).range(1..=1024))]
     threads: Option<u64>,
+    /// The plants drawn: `physical-default` (the physical reading, its open items at their
+    /// defaults) or `plant` (both readings and every open quantity over its range,
+    /// docs/model.md), reported per form; the page is written for the default family only.
+    #[arg(long, value_parser = family, default_value = "physical-default", value_name = "physical-default|plant")]
+    family: Family,
+}
+
+fn family(v: &str) -> Result<Family, String> {
+    Family::parse(v).ok_or_else(|| "expected physical-default or plant".into())
 }
 
 #[derive(Args, Debug)]
@@ -175,11 +185,7 @@ pub fn run_part(setup: &Setup, campaign: Campaign, k: u64, n: u64, threads: usiz
     let nominal = part::slice(campaign.runs, k, n);
     let faults = part::slice(campaign.fault_runs, k, n);
     let seed = campaign.seed;
-    let draw = if campaign.plant_family == LEGACY_FAMILY {
-        draw_legacy
-    } else {
-        draw
-    };
+    let draw = |seed, i, kind| draw_for(&campaign.plant_family, seed, i, kind);
     let mut draws: Vec<_> = nominal.clone().map(|i| draw(seed, i, None)).collect();
     for kind in FAULT_KINDS {
         draws.extend(faults.clone().map(|i| draw(seed, i, Some(kind))));
@@ -205,11 +211,42 @@ pub fn run_part(setup: &Setup, campaign: Campaign, k: u64, n: u64, threads: usiz
     Part::new(campaign, [k, n], nominal, faults, &outcomes)
 }
 
+/// Run `index` of a campaign of the named plant family.
+fn draw_for(
+    family: &str,
+    seed: u64,
+    index: u64,
+    fault: Option<noback_twin::fault::FaultKind>,
+) -> Draw {
+    if family == LEGACY_FAMILY {
+        return draw_legacy(seed, index, fault);
+    }
+    draw_in(
+        Family::parse(family).unwrap_or(Family::PhysicalDefault),
+        seed,
+        index,
+        fault,
+    )
+}
+
+/// The plant form of every run of a campaign, in the outcomes' order (nominal, then each
+/// fault kind): a function of the draws alone, so a merge finds what the runs drew.
+fn forms_of(campaign: &Campaign) -> Vec<&'static str> {
+    let form = |i, kind| {
+        host_tests::family::form(&draw_for(&campaign.plant_family, campaign.seed, i, kind).scene)
+    };
+    let mut forms: Vec<_> = (0..campaign.runs).map(|i| form(i, None)).collect();
+    for kind in FAULT_KINDS {
+        forms.extend((0..campaign.fault_runs).map(|i| form(i, Some(kind))));
+    }
+    forms
+}
+
 /// The campaign a run's arguments describe.
-fn campaign_of(setup: &Setup, seed: u64, runs: u64, fault_runs: u64) -> Campaign {
+fn campaign_of(setup: &Setup, family: Family, seed: u64, runs: u64, fault_runs: u64) -> Campaign {
     Campaign {
         seed,
-        plant_family: PLANT_FAMILY.into(),
+        plant_family: family.name().into(),
         config_digest: part::config_digest(&setup.config),
         pre_roll_s: setup.pre_roll_s,
         power_on_settle_s: setup.config.thresholds.power_on_settle_s,
@@ -228,7 +265,7 @@ fn run_main(a: &RunArgs) -> Result<(), Fail> {
     }
     noback::monitor::Monitor::new(setup.config)
         .map_err(|e| Fail::Input(format!("monitor configuration: {e:?}")))?;
-    let mut campaign = campaign_of(&setup, a.seed, a.runs, a.fault_runs);
+    let mut campaign = campaign_of(&setup, a.family, a.seed, a.runs, a.fault_runs);
     if a.legacy_draws {
         campaign.plant_family = LEGACY_FAMILY.into();
     }
@@ -244,8 +281,10 @@ fn run_main(a: &RunArgs) -> Result<(), Fail> {
     }
     // The page describes the shipped monitor: an ablation does not overwrite it.
     let shipped = Setup::default();
-    let ablation =
-        setup.config != shipped.config || setup.pre_roll_s != shipped.pre_roll_s || a.legacy_draws;
+    let ablation = setup.config != shipped.config
+        || setup.pre_roll_s != shipped.pre_roll_s
+        || a.legacy_draws
+        || a.family != Family::PhysicalDefault;
     // Through the part's text, as a merge reads it: the same bytes whichever way.
     let part = serde_json::from_str(&text).map_err(|e| e.to_string())?;
     let parts = [("the campaign".into(), part)];
@@ -276,11 +315,12 @@ fn merge_main(m: &MergeArgs) -> Result<(), Fail> {
             )));
         }
     }
-    let legacy = parts
+    // The page describes the default family's campaign drawn by today's stream.
+    let other_family = parts
         .first()
-        .is_some_and(|(_, p)| p.campaign.plant_family == LEGACY_FAMILY);
+        .is_some_and(|(_, p)| p.campaign.plant_family != Family::PhysicalDefault.name());
     let ablation =
-        setup.config != shipped.config || setup.pre_roll_s != shipped.pre_roll_s || legacy;
+        setup.config != shipped.config || setup.pre_roll_s != shipped.pre_roll_s || other_family;
     finish(
         &parts,
         m.prefix,
@@ -316,6 +356,9 @@ fn finish(
         println!("{report}");
     } else {
         println!("{}", page::table(&report));
+        if let Some(forms) = report["by_form"].as_object() {
+            println!("{}", report::form_table(forms));
+        }
     }
     Ok(())
 }
@@ -325,7 +368,7 @@ pub fn unsharded_report(seed: u64, runs: u64, fault_runs: u64) -> Result<String,
     let setup = Setup::default();
     let part = run_part(
         &setup,
-        campaign_of(&setup, seed, runs, fault_runs),
+        campaign_of(&setup, Family::PhysicalDefault, seed, runs, fault_runs),
         0,
         1,
         threads(None),
@@ -352,7 +395,10 @@ pub fn report_of(
         config: setup.config,
         pre_roll_s: campaign.pre_roll_s,
     };
-    let report = report::build(&meta, outcomes)?;
+    let mut report = report::build(&meta, outcomes)?;
+    if campaign.plant_family == Family::Plant.name() {
+        report["by_form"] = report::by_form(outcomes, &forms_of(campaign));
+    }
     let record_path = workspace_root().join(page::CAMPAIGN_RECORD);
     let record = match std::fs::read_to_string(&record_path) {
         Ok(text) => Some(

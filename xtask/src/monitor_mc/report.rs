@@ -166,3 +166,73 @@ pub fn context_name(c: Context) -> &'static str {
         Context::Other => "elsewhere",
     }
 }
+
+/// The plant forms a report groups runs by (`host_tests::family::form`).
+pub const FORMS: [&str; 2] = ["paper", "physical"];
+
+/// Per plant form: its nominal runs' false-alarm rate and each fault kind's detection among
+/// its manifested runs, with their intervals. `forms` is aligned with `outcomes`.
+pub fn by_form(outcomes: &[Outcome], forms: &[&str]) -> Value {
+    let mut out = serde_json::Map::new();
+    for form in FORMS {
+        let mine: Vec<&Outcome> = outcomes
+            .iter()
+            .zip(forms)
+            .filter(|(_, f)| **f == form)
+            .map(|(o, _)| o)
+            .collect();
+        let nominal: Vec<&&Outcome> = mine
+            .iter()
+            .filter(|o| o.fault.is_none() && o.error.is_none())
+            .collect();
+        let false_alarms = nominal.iter().filter(|o| o.false_flags > 0).count();
+        let mut detection = serde_json::Map::new();
+        for kind in FAULT_KINDS {
+            let manifested: Vec<&&Outcome> = mine
+                .iter()
+                .filter(|o| o.fault == Some(kind) && o.error.is_none() && o.manifested)
+                .collect();
+            let hits = manifested.iter().filter(|o| detected(o)).count();
+            detection.insert(format!("{kind:?}"), rate(hits, manifested.len()));
+        }
+        out.insert(
+            form.into(),
+            json!({
+                "false_alarm": rate(false_alarms, nominal.len()),
+                "errors": mine.iter().filter(|o| o.error.is_some()).count(),
+                "detection": detection,
+            }),
+        );
+    }
+    Value::Object(out)
+}
+
+/// [`by_form`] as text, one block per form.
+pub fn form_table(forms: &serde_json::Map<String, Value>) -> String {
+    let of = |v: &Value| {
+        let hi = v["ci95"][1]
+            .as_f64()
+            .map_or("—".into(), |h| format!("{h:.2e}"));
+        format!("{}/{} (95 % upper {hi})", v["of"][0], v["of"][1])
+    };
+    let mut text = String::from("per plant form:\n");
+    for (form, v) in forms {
+        text.push_str(&format!(
+            "  {form}: false alarms {}, twin errors {}\n",
+            of(&v["false_alarm"]),
+            v["errors"]
+        ));
+        if let Some(d) = v["detection"].as_object() {
+            for (kind, r) in d {
+                let lo = r["ci95"][0]
+                    .as_f64()
+                    .map_or("—".into(), |l| format!("{l:.3}"));
+                text.push_str(&format!(
+                    "    {kind:<13} detected {}/{} (95 % lower {lo})\n",
+                    r["of"][0], r["of"][1]
+                ));
+            }
+        }
+    }
+    text
+}

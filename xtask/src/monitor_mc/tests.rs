@@ -9,7 +9,10 @@ const FAULT_RUNS: u64 = 2;
 
 fn campaign() -> (Setup, Campaign) {
     let setup = Setup::default();
-    (setup, campaign_of(&setup, 5, RUNS, FAULT_RUNS))
+    (
+        setup,
+        campaign_of(&setup, Family::PhysicalDefault, 5, RUNS, FAULT_RUNS),
+    )
 }
 
 /// A part as a merge reads it: through its file's text.
@@ -41,6 +44,41 @@ fn shards_merge_to_the_unsharded_campaign_byte_for_byte() {
         assert_eq!(j.to_string(), json.to_string(), "{n} shards");
         assert_eq!(p, page, "{n} shards");
     }
+}
+
+#[test]
+fn a_plant_family_campaign_reports_each_form_and_merges_exactly() {
+    let setup = Setup::default();
+    let c = campaign_of(&setup, Family::Plant, 11, 12, 0);
+    let whole = through_text(&run_part(&setup, c.clone(), 0, 1, 2));
+    let (json, _) = report(&[("whole".into(), whole)]);
+    let forms = json["by_form"]
+        .as_object()
+        .expect("a plant campaign reports per form");
+    let nominal: u64 = forms
+        .values()
+        .map(|f| f["false_alarm"]["of"][1].as_u64().unwrap())
+        .sum();
+    assert_eq!(nominal, 12, "every nominal run falls in one form");
+    assert!(forms
+        .values()
+        .all(|f| f["false_alarm"]["of"][1].as_u64() > Some(0)));
+    let parts: Vec<(String, Part)> = (0..2)
+        .map(|k| {
+            (
+                format!("part-{k}"),
+                through_text(&run_part(&setup, c.clone(), k, 2, 1)),
+            )
+        })
+        .collect();
+    assert_eq!(report(&parts).0.to_string(), json.to_string());
+    // The default family's report has no per-form block.
+    let (setup, d) = campaign();
+    let plain = through_text(&run_part(&setup, d, 0, 1, 2));
+    assert!(report(&[("whole".into(), plain)])
+        .0
+        .get("by_form")
+        .is_none());
 }
 
 #[test]

@@ -1,0 +1,49 @@
+//! Where the uncommissioned monitor false-alarms on the plant family (docs/decisions.md, "The
+//! plant family in the Monte Carlo"): the healthy runs of `monitor-mc --family plant`, per
+//! form and scene kind, with the first flag each raised and whether the paper reading's pack
+//! slips at μ_s.
+//!
+//! `cargo run --release -p host-tests --example family_false_alarms -- [RUNS] [SEED]` (defaults
+//! 400 and 1616).
+
+use host_tests::accuracy::{compare, run_monitor};
+use host_tests::family::{form, Family};
+use host_tests::mc::{draw_in, draw_trace};
+use noback::monitor::Config;
+use std::collections::BTreeMap;
+
+fn main() -> Result<(), String> {
+    let mut args = std::env::args().skip(1);
+    let runs: u64 = args
+        .next()
+        .map_or(Ok(400), |s| s.parse())
+        .map_err(|e| format!("RUNS: {e}"))?;
+    let seed: u64 = args
+        .next()
+        .map_or(Ok(1616), |s| s.parse())
+        .map_err(|e| format!("SEED: {e}"))?;
+    let mut runs_by: BTreeMap<String, usize> = BTreeMap::new();
+    let mut flags_by: BTreeMap<String, usize> = BTreeMap::new();
+    for i in 0..runs {
+        let d = draw_in(Family::Plant, seed, i, None);
+        let key = format!("{} {:?}", form(&d.scene), d.scene.kind);
+        *runs_by.entry(key.clone()).or_default() += 1;
+        let trace = draw_trace(&d)?;
+        let acc = compare(&trace, &run_monitor(&trace, Config::default())?);
+        if let Some(f) = acc.flags.first() {
+            let mu = d.scene.open.paper_sliding_mu_static;
+            *flags_by
+                .entry(format!("{key}: {} (sliding μ_s {mu})", f.flag))
+                .or_default() += 1;
+        }
+    }
+    println!("healthy runs {runs} of seed {seed}, by form and scene kind:");
+    for (k, n) in &runs_by {
+        println!("{n:6}  {k}");
+    }
+    println!("false alarms by first flag:");
+    for (k, n) in &flags_by {
+        println!("{n:6}  {k}");
+    }
+    Ok(())
+}
