@@ -31,8 +31,13 @@ impl Fnv1a {
     /// Folds one word in (little-endian bytes, wrapping multiply by the FNV prime).
     pub fn push(&mut self, word: u32) {
         for byte in word.to_le_bytes() {
-            self.0 = (self.0 ^ u32::from(byte)).wrapping_mul(0x0100_0193);
+            self.push_byte(byte);
         }
+    }
+
+    /// Folds one byte in.
+    pub fn push_byte(&mut self, byte: u8) {
+        self.0 = (self.0 ^ u32::from(byte)).wrapping_mul(0x0100_0193);
     }
 
     /// The digest so far.

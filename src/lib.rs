@@ -15,6 +15,8 @@
 //! - [`board`], [`replay`], [`app`], [`event_log`]: the firmware's portable half — sensor
 //!   traits, the replayed twin trace, the work of one tick, the log ring buffer.
 //! - [`digest`]: the FNV-1a digest host and targets compare.
+//! - `trip_log` (feature `snapshot`): each flag change with its inputs and the monitor's state,
+//!   replayable bit-exact on the host.
 //! - [`exit_code`]: how a run under QEMU ends, shared with the xtask.
 //! - `platform` (target only): panic and HardFault exits, defmt transport.
 #![no_std]
@@ -30,6 +32,8 @@ pub mod monitor;
 pub mod replay;
 pub mod sensors;
 pub mod table1;
+#[cfg(feature = "snapshot")]
+pub mod trip_log;
 pub mod vectors;
 
 #[cfg(all(target_os = "none", feature = "platform"))]

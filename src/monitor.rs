@@ -101,6 +101,7 @@ pub fn mul_q16(a: Q16, b: Q16) -> Q16 {
 }
 
 /// The monitor's state: one value per stage.
+#[cfg_attr(feature = "snapshot", derive(serde::Serialize, serde::Deserialize))]
 #[derive(Clone, Debug)]
 struct State {
     tick: u32,
@@ -122,6 +123,7 @@ struct State {
 }
 
 /// The monitor: settings apart from state. One [`Monitor::step`] per tick.
+#[cfg_attr(feature = "snapshot", derive(serde::Serialize, serde::Deserialize))]
 #[derive(Clone, Debug)]
 pub struct Monitor {
     settings: Settings,
@@ -313,6 +315,7 @@ impl Monitor {
 }
 
 /// A tick's slow-lane work: its slot and what sensing and the observer handed on.
+#[cfg_attr(feature = "snapshot", derive(serde::Serialize, serde::Deserialize))]
 #[derive(Clone, Copy, Debug)]
 struct Job {
     slot: Slot,
@@ -321,6 +324,7 @@ struct Job {
 }
 
 /// What the slow lane hands the next tick.
+#[cfg_attr(feature = "snapshot", derive(serde::Serialize, serde::Deserialize))]
 #[derive(Clone, Copy, Debug)]
 struct SlowResult {
     raised: Flags,
@@ -456,6 +460,61 @@ impl State {
             flags: self.flags,
             ..self.estimate
         }
+    }
+}
+
+/// Why a saved state could not be written or read back.
+#[cfg(feature = "snapshot")]
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum SnapshotError {
+    /// The buffer is too small for the state.
+    BufferFull,
+    /// The bytes are not a state this build saved.
+    Corrupt,
+    /// The configuration was rejected.
+    Config(ConfigError),
+}
+
+/// A postcard output that folds the bytes into a digest instead of storing them.
+#[cfg(feature = "snapshot")]
+struct DigestFlavor(crate::digest::Fnv1a);
+
+#[cfg(feature = "snapshot")]
+impl postcard::ser_flavors::Flavor for DigestFlavor {
+    type Output = u32;
+    fn try_push(&mut self, byte: u8) -> postcard::Result<()> {
+        self.0.push_byte(byte);
+        Ok(())
+    }
+    fn finalize(self) -> postcard::Result<u32> {
+        Ok(self.0.value())
+    }
+}
+
+/// The monitor's state as bytes (postcard), for a trip record: a monitor restored from them
+/// with the same configuration steps on exactly as the one that saved them.
+#[cfg(feature = "snapshot")]
+impl Monitor {
+    /// Writes the state (everything but the settings, which the configuration gives) into
+    /// `buf`; returns the bytes used.
+    pub fn save_state<'b>(&self, buf: &'b mut [u8]) -> Result<&'b mut [u8], SnapshotError> {
+        postcard::to_slice(&(&self.state, &self.job, self.job_due), buf)
+            .map_err(|_| SnapshotError::BufferFull)
+    }
+
+    /// FNV-1a over the settings' bytes: which configuration a saved state belongs with.
+    pub fn settings_digest(&self) -> u32 {
+        postcard::serialize_with_flavor(&self.settings, DigestFlavor(crate::digest::Fnv1a::new()))
+            .unwrap_or(0)
+    }
+
+    /// The monitor `config` builds, in the state `bytes` (from [`Monitor::save_state`]).
+    pub fn restore(config: Config, bytes: &[u8]) -> Result<Monitor, SnapshotError> {
+        let mut monitor = Monitor::new(config).map_err(SnapshotError::Config)?;
+        let (state, job, job_due) =
+            postcard::from_bytes(bytes).map_err(|_| SnapshotError::Corrupt)?;
+        (monitor.state, monitor.job, monitor.job_due) = (state, job, job_due);
+        Ok(monitor)
     }
 }
 

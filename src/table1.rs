@@ -55,6 +55,7 @@ impl Torque for f32 {
 }
 
 /// The output's motion relative to the pack.
+#[cfg_attr(feature = "snapshot", derive(serde::Serialize, serde::Deserialize))]
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Motion {
     /// Within the stick band (or held): the pack carries the demand.

@@ -9,5 +9,7 @@ pub mod accuracy;
 pub mod family;
 pub mod fuzz;
 pub mod mc;
+pub mod power_fail;
 pub mod robustness;
+pub mod sim_flash;
 pub mod stats;

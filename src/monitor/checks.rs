@@ -38,6 +38,7 @@ use envelope::Envelope;
 use hold::HoldChecks;
 
 /// The checks' constants.
+#[cfg_attr(feature = "snapshot", derive(serde::Serialize, serde::Deserialize))]
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub(crate) struct CheckSettings {
     persistence_ticks: u32,
@@ -75,6 +76,7 @@ pub(crate) struct CheckInputs {
 }
 
 /// The checks' state.
+#[cfg_attr(feature = "snapshot", derive(serde::Serialize, serde::Deserialize))]
 #[derive(Clone, Copy, Debug)]
 pub(crate) struct Checks {
     weak_ticks: u32,

@@ -27,6 +27,7 @@ use crate::fx::Q16;
 use fixed::types::U40F24;
 
 /// The estimate's constants.
+#[cfg_attr(feature = "snapshot", derive(serde::Serialize, serde::Deserialize))]
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub(crate) struct EstimateSettings {
     /// Q16 W → U40F24 J per tick.
@@ -43,6 +44,7 @@ impl EstimateSettings {
 }
 
 /// The pack's state at the last classification.
+#[cfg_attr(feature = "snapshot", derive(serde::Serialize, serde::Deserialize))]
 #[derive(Clone, Copy, Debug)]
 pub(crate) struct PackEstimate {
     pub force: Q16,
@@ -138,6 +140,7 @@ pub(crate) fn pack(k: &PackSettings, c: &Classified, i: &PackInputs) -> PackEsti
 
 /// Friction energy: slip power `|T·ω|` integrated in the slow lane over the ticks since its
 /// last sample (a heat estimate; saturating, monotone).
+#[cfg_attr(feature = "snapshot", derive(serde::Serialize, serde::Deserialize))]
 #[derive(Clone, Copy, Debug)]
 pub(crate) struct Energy {
     pub joules: U40F24,

@@ -8,6 +8,7 @@ use crate::fx::Q16;
 use fixed::types::U40F24;
 
 /// The raw readings of one tick.
+#[cfg_attr(feature = "snapshot", derive(serde::Serialize, serde::Deserialize))]
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct Inputs {
     /// Phase-current ADC code, offset binary (mid-scale = 0 A). Codes above the converter's
@@ -44,6 +45,7 @@ impl Inputs {
 }
 
 /// The situation the monitor recognised; it selects the model used in the step.
+#[cfg_attr(feature = "snapshot", derive(serde::Serialize, serde::Deserialize))]
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 #[repr(u8)]
 pub enum Scene {
@@ -72,6 +74,7 @@ pub enum Scene {
 ///     SceneModel::ReducedI16F16Euler { rate_hz: 1000 }
 /// );
 /// ```
+#[cfg_attr(feature = "snapshot", derive(serde::Serialize, serde::Deserialize))]
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum SceneModel {
     /// No state to advance: the output at rest under the pack (holding) or at the drive's
@@ -100,6 +103,7 @@ impl core::fmt::Display for SceneModel {
 }
 
 /// State of the friction pack.
+#[cfg_attr(feature = "snapshot", derive(serde::Serialize, serde::Deserialize))]
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 #[repr(u8)]
 pub enum BrakeState {
@@ -113,6 +117,7 @@ pub enum BrakeState {
 
 /// Failure flags. In [`Estimate::flags`] they are latched: once raised they stay until
 /// `Monitor::reset_flags`.
+#[cfg_attr(feature = "snapshot", derive(serde::Serialize, serde::Deserialize))]
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct Flags {
     /// The output moved beyond the creep limit with the drive off after the brake had locked.
@@ -187,6 +192,7 @@ pub const ESTIMATE_WORDS: usize = 14;
 
 /// The monitor's output for one tick. Signs follow the output shaft: positive = the direction
 /// in which a positive load torque turns it.
+#[cfg_attr(feature = "snapshot", derive(serde::Serialize, serde::Deserialize))]
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct Estimate {
     /// Tick counter (wraps after 2^32 ticks, 5 days at 10 kHz).

@@ -16,6 +16,7 @@ use super::sense::{times, SenseSettings, Sensed};
 use crate::fx::{counter_delta, Q16};
 
 /// The observer stage's constants.
+#[cfg_attr(feature = "snapshot", derive(serde::Serialize, serde::Deserialize))]
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub(crate) struct ObserveSettings {
     pub obs: ObserverScales,
@@ -108,6 +109,7 @@ impl ObserveSettings {
 }
 
 /// What the observer stage hands on.
+#[cfg_attr(feature = "snapshot", derive(serde::Serialize, serde::Deserialize))]
 #[derive(Clone, Copy, Debug)]
 pub(crate) struct Observed {
     /// Output speed ω̂.
@@ -144,6 +146,7 @@ impl Observed {
 
 /// The power-on seeding: after [`POWER_ON_SEED_TICKS`] on-time, plausible ticks the observer
 /// starts from the output's measured speed with its torque balanced, instead of at rest.
+#[cfg_attr(feature = "snapshot", derive(serde::Serialize, serde::Deserialize))]
 #[derive(Clone, Copy, Debug, Default)]
 struct PowerOnSeed {
     /// Ticks left (0: done, or given up).
@@ -153,6 +156,7 @@ struct PowerOnSeed {
 }
 
 /// The observer stage's state.
+#[cfg_attr(feature = "snapshot", derive(serde::Serialize, serde::Deserialize))]
 #[derive(Clone, Copy, Debug)]
 pub(crate) struct Observe {
     obs: Observer,

@@ -16,6 +16,7 @@ use super::convert::{finite, positive, scale, Q16_ONE};
 use super::scale::Scale;
 
 /// The observer's constants (derived in [`ObserverScales::new`]).
+#[cfg_attr(feature = "snapshot", derive(serde::Serialize, serde::Deserialize))]
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub(crate) struct ObserverScales {
     /// Q16 rad/s → angle words per tick (≈ 1.04 by default).
@@ -78,6 +79,7 @@ impl ObserverScales {
 }
 
 /// Observer state.
+#[cfg_attr(feature = "snapshot", derive(serde::Serialize, serde::Deserialize))]
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
 pub(crate) struct Observer {
     /// Angle, 2³² words per turn.

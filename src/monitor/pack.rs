@@ -16,6 +16,7 @@ use crate::fx::Q16;
 use crate::table1::Motion;
 
 /// Exact (f64) ratios of the pack that other stages' constants derive from.
+#[cfg_attr(feature = "snapshot", derive(serde::Serialize, serde::Deserialize))]
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub(crate) struct PackRatios {
     /// `a·k = μ_d·c·tanθ/r`, the sliding self-locking ratio (1.42 at Table 2).
@@ -25,6 +26,7 @@ pub(crate) struct PackRatios {
 }
 
 /// The pack's constants, converted once.
+#[cfg_attr(feature = "snapshot", derive(serde::Serialize, serde::Deserialize))]
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub(crate) struct PackSettings {
     pub spring_force: Q16,
@@ -139,6 +141,7 @@ pub(crate) fn table1(stuck: bool, dir: Dir, demand: Q16, capacity: Q16) -> Q16 {
 }
 
 /// A direction of motion or load: −1, 0 (within a dead band) or +1.
+#[cfg_attr(feature = "snapshot", derive(serde::Serialize, serde::Deserialize))]
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
 pub(crate) struct Dir(i32);
 

@@ -26,6 +26,7 @@ use super::{convert::scale, Scene};
 use crate::fx::{counter_delta, Q16};
 
 /// The classifier's constants.
+#[cfg_attr(feature = "snapshot", derive(serde::Serialize, serde::Deserialize))]
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub(crate) struct SceneSettings {
     pub stick_speed: Q16,
@@ -74,6 +75,7 @@ impl SceneSettings {
 }
 
 /// Who carries the load while the drive runs.
+#[cfg_attr(feature = "snapshot", derive(serde::Serialize, serde::Deserialize))]
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub(crate) struct Reading {
     pub overrunning: bool,
@@ -84,6 +86,7 @@ pub(crate) struct Reading {
 }
 
 /// The scene state machine.
+#[cfg_attr(feature = "snapshot", derive(serde::Serialize, serde::Deserialize))]
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub(crate) enum Phase {
     Driving(Reading),
@@ -92,6 +95,7 @@ pub(crate) enum Phase {
 }
 
 /// What classifying hands on.
+#[cfg_attr(feature = "snapshot", derive(serde::Serialize, serde::Deserialize))]
 #[derive(Clone, Copy, Debug)]
 pub(crate) struct Classified {
     pub scene: Scene,
@@ -138,6 +142,7 @@ impl Classified {
 }
 
 /// The classifier's state.
+#[cfg_attr(feature = "snapshot", derive(serde::Serialize, serde::Deserialize))]
 #[derive(Clone, Copy, Debug)]
 pub(crate) struct Classify {
     pub phase: Phase,

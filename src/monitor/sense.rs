@@ -21,6 +21,7 @@ use crate::fx::{lowpass, Gain, Q16};
 const POSITION_HISTORY: usize = 64;
 
 /// The sensors' constants.
+#[cfg_attr(feature = "snapshot", derive(serde::Serialize, serde::Deserialize))]
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub(crate) struct SenseSettings {
     adc_max_code: u16,
@@ -143,6 +144,7 @@ impl SenseSettings {
 }
 
 /// What sensing hands on for one call.
+#[cfg_attr(feature = "snapshot", derive(serde::Serialize, serde::Deserialize))]
 #[derive(Clone, Copy, Debug)]
 pub(crate) struct Sensed {
     /// Ticks covered (1 when on time, ≤ 255).
@@ -185,6 +187,7 @@ impl Sensed {
 }
 
 /// The sensors' memory.
+#[cfg_attr(feature = "snapshot", derive(serde::Serialize, serde::Deserialize))]
 #[derive(Clone, Debug)]
 pub(crate) struct Sense {
     started: bool,
@@ -197,6 +200,7 @@ pub(crate) struct Sense {
     input_speed: Q16,
     /// The motor counter at the last input-speed sample.
     speed_motor: u32,
+    #[cfg_attr(feature = "snapshot", serde(with = "serde_big_array::BigArray"))]
     positions: [i16; POSITION_HISTORY],
     position_head: usize,
     /// Consecutive on-time plausible ticks with the drive off in the history.

@@ -12,6 +12,7 @@ use super::scene::SceneSettings;
 use super::sense::SenseSettings;
 
 /// Every stage's settings.
+#[cfg_attr(feature = "snapshot", derive(serde::Serialize, serde::Deserialize))]
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub(crate) struct Settings {
     pub sense: SenseSettings,

@@ -27,6 +27,7 @@ mod snapshot;
 mod test;
 #[cfg(test)]
 mod tidy;
+mod trip_log;
 mod twin_bench;
 
 use clap::{CommandFactory, Parser, Subcommand};
@@ -73,6 +74,10 @@ enum Cmd {
     Reliability(reliability::ReliabilityArgs),
     /// Speed against accuracy of model variants; writes docs/results/speed-accuracy.* etc.
     Bench(BenchArgs),
+    /// The trip log on the host: record a scene's trips, dump a flash region, replay a record.
+    Log(trip_log::LogArgs),
+    /// The trip log's power-loss test: a cut at every flash step, records lost and corrupt.
+    PowerFail(trip_log::PowerFailArgs),
     /// Add missing rustup targets and install qemu-system-arm if missing.
     Bootstrap,
 }
@@ -157,6 +162,8 @@ fn dispatch(args: &[String]) -> i32 {
         Cmd::OptLevel => opt_level::main(),
         Cmd::Reliability(a) => reliability::main(&a),
         Cmd::Bench(_) => bench::main(rest),
+        Cmd::Log(a) => trip_log::main(&a),
+        Cmd::PowerFail(a) => trip_log::power_fail(&a),
         Cmd::Bootstrap => bootstrap::ensure_all().map(|()| 0),
     };
     match result {

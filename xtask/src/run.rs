@@ -90,7 +90,7 @@ pub fn line_with<'a>(
         .ok_or_else(|| format!("the firmware printed no `{word}` line"))
 }
 
-fn flag_names(bits: u8) -> Vec<&'static str> {
+pub fn flag_names(bits: u8) -> Vec<&'static str> {
     let f = Flags::from_bits(bits);
     [
         (f.brake_slip, "brake_slip"),

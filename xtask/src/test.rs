@@ -98,6 +98,10 @@ pub fn main(a: &TestArgs) -> Result<i32, String> {
         "pages reproduce (reliability and paper against their committed pages, monitor-mc twice)",
     );
     crate::pages::reproduce()?;
+    section(
+        "trip log: power cut at every flash step; each trip of a fault scene replayed bit-exact",
+    );
+    trip_log_holds()?;
     section("Slurm: a sharded Monte Carlo as a job array, merged = unsharded");
     crate::slurm_test::stage()?;
 
@@ -325,6 +329,23 @@ fn run_and_monitor_agree_on_time() -> Result<(), String> {
         Ok(())
     } else {
         Err("run and monitor report different flags or times on the same scene".into())
+    }
+}
+
+/// The trip log's power-loss test and the replay of a fault scene's records (host side).
+fn trip_log_holds() -> Result<(), String> {
+    let code = crate::trip_log::power_fail(&crate::trip_log::PowerFailArgs { json: false })?;
+    let (records, _) = crate::trip_log::record_scene(&fault_scene()?)?;
+    let mut all = code == 0 && !records.is_empty();
+    for bytes in &records {
+        let (same, line) = crate::trip_log::replay(bytes)?;
+        println!("{line}");
+        all &= same;
+    }
+    if all {
+        Ok(())
+    } else {
+        Err("the trip log lost or misread a record under power loss, or a record did not replay bit-exact".into())
     }
 }
 

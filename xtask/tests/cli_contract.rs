@@ -65,6 +65,8 @@ const COMMANDS: &[&str] = &[
     "opt-level",
     "reliability",
     "bench",
+    "log",
+    "power-fail",
     "bootstrap",
 ];
 

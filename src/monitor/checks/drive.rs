@@ -22,6 +22,7 @@ use crate::monitor::schedule::SLOW;
 use crate::monitor::Flags;
 
 /// The drive checks' constants.
+#[cfg_attr(feature = "snapshot", derive(serde::Serialize, serde::Deserialize))]
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub(crate) struct DriveSettings {
     persistence_ticks: u32,
@@ -89,6 +90,7 @@ impl DriveSettings {
 }
 
 /// State of the drive checks.
+#[cfg_attr(feature = "snapshot", derive(serde::Serialize, serde::Deserialize))]
 #[derive(Clone, Copy, Debug, Default)]
 pub(crate) struct DriveChecks {
     /// Ticks the pack has dragged beyond the allowance.

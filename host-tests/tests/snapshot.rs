@@ -1,0 +1,52 @@
+//! A monitor restored from its saved state steps on exactly as the one that saved it, from any
+//! tick of a scene: what lets a trip record be replayed bit-exact on the host.
+
+use host_tests::accuracy::scene_trace;
+use noback::monitor::{Config, Inputs, Monitor, SnapshotError};
+use noback_twin::scene::Scene;
+
+fn inputs(r: &noback_twin::trace::TraceRow) -> Inputs {
+    Inputs::new(r.current_code, r.motor_count, r.output_count, r.drive_on)
+}
+
+#[test]
+fn a_restored_monitor_steps_on_bit_exact() {
+    let text = "[scene]\nkind = \"reverse_load\"\n[[fault]]\nkind = \"friction_loss\"\nat_s = 0.2\nseverity = 0.8\n";
+    let trace = scene_trace(&Scene::from_toml("snap", text).unwrap()).unwrap();
+    let mut largest = 0;
+    for cut in [1, 7, 1000, 2003, 2500, 4001] {
+        let mut a = Monitor::new(Config::default()).unwrap();
+        for r in &trace.rows[..cut] {
+            a.step(&inputs(r));
+        }
+        let mut buf = [0_u8; 4096];
+        let bytes = a.save_state(&mut buf).unwrap().to_vec();
+        largest = largest.max(bytes.len());
+        let mut b = Monitor::restore(Config::default(), &bytes).unwrap();
+        for r in &trace.rows[cut..] {
+            assert_eq!(
+                a.step(&inputs(r)).to_words(),
+                b.step(&inputs(r)).to_words(),
+                "cut at {cut}"
+            );
+        }
+    }
+    println!("largest saved state: {largest} bytes");
+    assert!(largest < 2048, "{largest} bytes");
+}
+
+#[test]
+fn a_short_buffer_or_corrupt_bytes_are_refused() {
+    let m = Monitor::new(Config::default()).unwrap();
+    let mut small = [0_u8; 16];
+    assert_eq!(
+        m.save_state(&mut small).unwrap_err(),
+        SnapshotError::BufferFull
+    );
+    let mut buf = [0_u8; 4096];
+    let n = m.save_state(&mut buf).unwrap().len();
+    assert_eq!(
+        Monitor::restore(Config::default(), &buf[..n / 2]).unwrap_err(),
+        SnapshotError::Corrupt
+    );
+}

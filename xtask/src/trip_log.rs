@@ -1,0 +1,277 @@
+//! `cargo xtask log record|dump|replay` and `cargo xtask power-fail`: the trip log on the host.
+//!
+//! `log record` runs a scene through the twin and the monitor with the trip recorder and the
+//! store on a simulated STM32F405 flash region (four 16 KB sectors), and writes the region's
+//! bytes — what a ground crew reads off an ECU; `log dump` decodes a region's records;
+//! `log replay FILE --record K` replays record K from its saved state and must end on the
+//! recorded estimate, bit for bit. `power-fail` is the power-loss test (`host_tests::power_fail`).
+
+use crate::shell::workspace_root;
+use host_tests::sim_flash::{SimFlash, F405_SECTOR};
+use noback::monitor::{Config, Flags, Inputs, Monitor};
+use noback::trip_log::record::{decode, Record};
+use noback::trip_log::store::Store;
+use noback::trip_log::Recorder;
+use noback_twin::args::bad_input;
+use serde_json::json;
+use std::path::PathBuf;
+
+/// Sectors of the trip log's region.
+pub const SECTORS: usize = 4;
+
+type Flash = SimFlash<F405_SECTOR>;
+
+/// `log`'s subcommands.
+#[derive(clap::Subcommand, Debug)]
+pub enum LogCmd {
+    /// Run a scene on the host with the trip recorder; write the flash region's bytes.
+    Record {
+        /// A built-in scene or a TOML scene file.
+        scene: String,
+        /// Where the region goes (default target/trip-log/SCENE.flash).
+        #[arg(long)]
+        out: Option<PathBuf>,
+    },
+    /// Decode the records of a flash region.
+    Dump {
+        /// A flash region's bytes (`log record`'s output).
+        file: PathBuf,
+        /// Print the records as one JSON array.
+        #[arg(long)]
+        json: bool,
+    },
+    /// Replay one record from its saved state; it must end on its estimate, bit for bit.
+    Replay {
+        /// A flash region's bytes.
+        file: PathBuf,
+        /// The record's index in `log dump`'s list.
+        #[arg(long, default_value_t = 0)]
+        record: usize,
+    },
+}
+
+/// `cargo xtask log`'s options.
+#[derive(clap::Args, Debug)]
+pub struct LogArgs {
+    #[command(subcommand)]
+    pub cmd: LogCmd,
+}
+
+fn store(flash: Flash) -> Result<Store<Flash>, String> {
+    Store::new(flash, 0..(SECTORS * F405_SECTOR) as u32).map_err(|e| format!("store: {e:?}"))
+}
+
+/// Entry of `log`.
+pub fn main(a: &LogArgs) -> Result<i32, String> {
+    match &a.cmd {
+        LogCmd::Record { scene, out } => record(scene, out.as_ref()),
+        LogCmd::Dump { file, json } => {
+            let records = match read(file) {
+                Ok(r) => r,
+                Err(e) => return Ok(bad_input("log", &e)),
+            };
+            let rows: Vec<_> = records
+                .iter()
+                .filter_map(|b| decode(b).ok())
+                .map(|r| describe(&r))
+                .collect();
+            if *json {
+                println!("{}", serde_json::Value::Array(rows));
+            } else {
+                println!("{} records in {}", rows.len(), file.display());
+                for (k, r) in rows.iter().enumerate() {
+                    println!(
+                        "{k}: tick {} (t = {} s) {} → {}, window {} inputs, state {} B, configuration {}",
+                        r["tick"], r["t_s"], r["before"].as_str().unwrap_or(""), r["now"].as_str().unwrap_or(""),
+                        r["window_inputs"], r["state_bytes"], r["config_digest"].as_str().unwrap_or("")
+                    );
+                }
+            }
+            Ok(0)
+        }
+        LogCmd::Replay { file, record } => {
+            let records = match read(file) {
+                Ok(r) => r,
+                Err(e) => return Ok(bad_input("log", &e)),
+            };
+            let Some(bytes) = records.get(*record) else {
+                return Ok(bad_input(
+                    "log",
+                    &format!(
+                        "--record {record}: the region holds {} records",
+                        records.len()
+                    ),
+                ));
+            };
+            let (same, line) = replay(bytes)?;
+            println!("{line}");
+            Ok(if same { 0 } else { 1 })
+        }
+    }
+}
+
+/// Replays one record; returns whether it reproduced its estimate and a line saying so.
+pub fn replay(bytes: &[u8]) -> Result<(bool, String), String> {
+    let r = decode(bytes).map_err(|e| format!("record: {e:?}"))?;
+    let config = Config::default();
+    let digest = Monitor::new(config)
+        .map_err(|e| format!("{e:?}"))?
+        .settings_digest();
+    if digest != r.config_digest {
+        return Err(format!("the record's configuration digest {:#010x} is not the default configuration's {digest:#010x}", r.config_digest));
+    }
+    let last = r.replay(config).map_err(|e| format!("replay: {e:?}"))?;
+    let same = last.to_words() == r.estimate && last.flags == r.now && last.tick == r.tick;
+    Ok((
+        same,
+        format!(
+            "record at tick {}: {} → {} over {} inputs from its saved state: {}",
+            r.tick,
+            names(r.before),
+            names(r.now),
+            r.window_len(),
+            if same {
+                "reproduced bit-exact"
+            } else {
+                "DIFFERENT"
+            }
+        ),
+    ))
+}
+
+fn names(f: Flags) -> String {
+    let n = crate::run::flag_names(f.bits());
+    if n.is_empty() {
+        "none".into()
+    } else {
+        n.join("+")
+    }
+}
+
+fn describe(r: &Record<'_>) -> serde_json::Value {
+    json!({
+        "tick": r.tick,
+        "t_s": f64::from(r.tick.saturating_sub(1)) / 10_000.0,
+        "before": names(r.before),
+        "now": names(r.now),
+        "window_inputs": r.window_len(),
+        "state_bytes": r.state.len(),
+        "config_digest": format!("{:#010x}", r.config_digest),
+    })
+}
+
+/// The records of a region file, oldest first.
+fn read(file: &PathBuf) -> Result<Vec<Vec<u8>>, String> {
+    let bytes = std::fs::read(file).map_err(|e| format!("{}: {e}", file.display()))?;
+    if bytes.len() != SECTORS * F405_SECTOR {
+        return Err(format!(
+            "{}: not a trip-log region ({} bytes, expected {})",
+            file.display(),
+            bytes.len(),
+            SECTORS * F405_SECTOR
+        ));
+    }
+    let mut s = store(Flash::from_bytes(bytes))?;
+    let mut out = Vec::new();
+    let mut buf = vec![0_u8; F405_SECTOR];
+    s.for_each(&mut buf, |item| out.push(item.to_vec()))
+        .map_err(|e| format!("{}: {e:?}", file.display()))?;
+    Ok(out)
+}
+
+/// The records of a host run of `scene` (a record at each flag change) and the region.
+pub fn record_scene(scene: &str) -> Result<(Vec<Vec<u8>>, Vec<u8>), String> {
+    let s = noback_twin::cli::load_scene(scene, None)?;
+    let trace = host_tests::accuracy::scene_trace(&s)?;
+    let mut monitor = Monitor::new(Config::default()).map_err(|e| format!("{e:?}"))?;
+    let mut recorder = Recorder::<{ noback::trip_log::RING_INPUTS }>::new();
+    let mut st = store(Flash::new(SECTORS))?;
+    let mut records = Vec::new();
+    let mut before = Flags::default();
+    let mut buf = vec![0_u8; 8192];
+    for r in &trace.rows {
+        let inputs = Inputs::new(r.current_code, r.motor_count, r.output_count, r.drive_on);
+        recorder.before_step(&monitor, &inputs);
+        let e = monitor.step(&inputs);
+        if e.flags != before {
+            let bytes = recorder
+                .record(&mut buf, &e, before)
+                .map_err(|e| format!("{e:?}"))?;
+            st.push(bytes).map_err(|e| format!("store: {e:?}"))?;
+            records.push(bytes.to_vec());
+        }
+        before = e.flags;
+    }
+    Ok((records, st.into_flash().bytes))
+}
+
+fn record(scene: &str, out: Option<&PathBuf>) -> Result<i32, String> {
+    if let Err(e) = noback_twin::cli::load_scene(scene, None) {
+        return Ok(bad_input("log", &e));
+    }
+    let (records, region) = record_scene(scene)?;
+    let stem = std::path::Path::new(scene)
+        .file_stem()
+        .map_or("scene".into(), |s| s.to_string_lossy().into_owned());
+    let path = out.cloned().unwrap_or_else(|| {
+        workspace_root()
+            .join("target")
+            .join("trip-log")
+            .join(format!("{stem}.flash"))
+    });
+    if let Some(dir) = path.parent() {
+        std::fs::create_dir_all(dir).map_err(|e| e.to_string())?;
+    }
+    std::fs::write(&path, region).map_err(|e| format!("{}: {e}", path.display()))?;
+    println!(
+        "{} records ({} bytes largest) -> {}",
+        records.len(),
+        records.iter().map(Vec::len).max().unwrap_or(0),
+        path.display()
+    );
+    Ok(0)
+}
+
+/// `cargo xtask power-fail`'s options.
+#[derive(clap::Args, Debug)]
+pub struct PowerFailArgs {
+    /// Print the figures as one JSON object.
+    #[arg(long)]
+    pub json: bool,
+}
+
+/// Entry of `power-fail`: exit 1 if a record was lost or read corrupt.
+pub fn power_fail(a: &PowerFailArgs) -> Result<i32, String> {
+    let records = host_tests::power_fail::sample_records(14)?;
+    let f = host_tests::power_fail::run(&records)?;
+    let v = json!({
+        "cuts": f.cuts,
+        "records_lost": f.records_lost,
+        "corrupt_reads": f.corrupt_reads,
+        "in_flight_whole": f.in_flight_whole,
+        "in_flight_absent": f.in_flight_absent,
+        "stopped_working": f.stopped_working,
+        "overflow": {"pushed": f.pushed, "kept": f.kept, "dropped_oldest": f.dropped},
+        "record_bytes_max": f.record_bytes,
+        "flash_steps": f.steps,
+        "words_programmed_per_record": (f.words_per_record * 10.0).round() / 10.0,
+        "erases_per_record": (f.erases_per_record * 1000.0).round() / 1000.0,
+        "page_bytes": host_tests::power_fail::PAGE,
+        "pages": host_tests::power_fail::PAGES,
+    });
+    if a.json {
+        println!("{v}");
+    } else {
+        println!(
+            "power cut at every one of {} steps: records lost {}, corrupt reads {}, the record in flight whole {} / absent {}, store stopped working {}; overflow: {} pushed, {} kept, {} oldest dropped",
+            f.cuts, f.records_lost, f.corrupt_reads, f.in_flight_whole, f.in_flight_absent, f.stopped_working, f.pushed, f.kept, f.dropped
+        );
+    }
+    Ok(
+        if f.records_lost == 0 && f.corrupt_reads == 0 && f.stopped_working == 0 {
+            0
+        } else {
+            1
+        },
+    )
+}
