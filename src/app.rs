@@ -12,7 +12,7 @@
 use crate::board::SampleSource;
 use crate::digest::Fnv1a;
 use crate::event_log::{Event, EventLog};
-use crate::monitor::{Estimate, Flags, Monitor};
+use crate::monitor::{Estimate, Flags, Inputs, Monitor};
 use embedded_hal::digital::OutputPin;
 
 /// Events the log holds between two drains of the main loop.
@@ -41,6 +41,7 @@ pub struct Ticker<S, P> {
     alarm_errors: u32,
     digest: Fnv1a,
     last: Option<Estimate>,
+    last_inputs: Option<Inputs>,
 }
 
 /// Counters a run reports at its end.
@@ -76,6 +77,7 @@ impl<S: SampleSource, P: OutputPin> Ticker<S, P> {
             alarm_errors,
             digest: Fnv1a::new(),
             last: None,
+            last_inputs: None,
         }
     }
 
@@ -95,6 +97,7 @@ impl<S: SampleSource, P: OutputPin> Ticker<S, P> {
         }
         let mut inputs = self.source.sample()?;
         inputs.ticks_elapsed = n;
+        self.last_inputs = Some(inputs);
         let estimate = self.monitor.tick(&inputs);
         self.ticks = self.ticks.saturating_add(1);
         self.digest.push(estimate_checksum(&estimate));
@@ -148,6 +151,16 @@ impl<S: SampleSource, P: OutputPin> Ticker<S, P> {
     /// The last estimate.
     pub fn last_estimate(&self) -> Option<Estimate> {
         self.last
+    }
+
+    /// The inputs the last tick stepped on (as the monitor saw them: ticks elapsed included).
+    pub fn last_inputs(&self) -> Option<Inputs> {
+        self.last_inputs
+    }
+
+    /// The monitor (e.g. for the trip recorder's copy between two ticks).
+    pub fn monitor(&self) -> &Monitor {
+        &self.monitor
     }
 
     /// Counters so far.

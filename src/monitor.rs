@@ -101,7 +101,10 @@ pub fn mul_q16(a: Q16, b: Q16) -> Q16 {
 }
 
 /// The monitor's state: one value per stage.
-#[cfg_attr(feature = "snapshot", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(
+    feature = "snapshot",
+    derive(serde::Serialize, serde::Deserialize, Hash)
+)]
 #[derive(Clone, Debug)]
 struct State {
     tick: u32,
@@ -118,12 +121,17 @@ struct State {
     energy: Energy,
     checks: Checks,
     flags: Flags,
+    /// A brake or sensor flag is latched (`Flags::fault`): no estimate is trusted.
+    fault_latched: bool,
     /// The last slow-lane run's results, until the next tick applies them.
     slow: SlowResult,
 }
 
 /// The monitor: settings apart from state. One [`Monitor::step`] per tick.
-#[cfg_attr(feature = "snapshot", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(
+    feature = "snapshot",
+    derive(serde::Serialize, serde::Deserialize, Hash)
+)]
 #[derive(Clone, Debug)]
 pub struct Monitor {
     settings: Settings,
@@ -161,6 +169,7 @@ impl Monitor {
                 energy: Energy::new(),
                 checks: Checks::new(),
                 flags: Flags::default(),
+                fault_latched: false,
                 slow: SlowResult::NONE,
             },
             job: Job {
@@ -194,6 +203,7 @@ impl Monitor {
     /// Clears the latched flags (a condition still present raises its flag again).
     pub fn reset_flags(&mut self) {
         self.state.flags = Flags::default();
+        self.state.fault_latched = false;
         let counters = self.state.sense.counters();
         self.state.checks.reset(counters);
     }
@@ -273,6 +283,7 @@ impl Monitor {
         raised.sensor_fault |= o.fault;
         raised.overrun |= n > 1;
         st.flags = st.flags.union(raised);
+        st.fault_latched |= raised.fault();
         st.slow = SlowResult::NONE;
         self.job_due = true;
         st.report(o)
@@ -315,7 +326,10 @@ impl Monitor {
 }
 
 /// A tick's slow-lane work: its slot and what sensing and the observer handed on.
-#[cfg_attr(feature = "snapshot", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(
+    feature = "snapshot",
+    derive(serde::Serialize, serde::Deserialize, Hash)
+)]
 #[derive(Clone, Copy, Debug)]
 struct Job {
     slot: Slot,
@@ -324,7 +338,10 @@ struct Job {
 }
 
 /// What the slow lane hands the next tick.
-#[cfg_attr(feature = "snapshot", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(
+    feature = "snapshot",
+    derive(serde::Serialize, serde::Deserialize, Hash)
+)]
 #[derive(Clone, Copy, Debug)]
 struct SlowResult {
     raised: Flags,
@@ -456,7 +473,7 @@ impl State {
                 && o.settled
                 && o.sensors_ok
                 && o.in_time
-                && !self.flags.fault(),
+                && !self.fault_latched,
             flags: self.flags,
             ..self.estimate
         }
@@ -475,19 +492,24 @@ pub enum SnapshotError {
     Config(ConfigError),
 }
 
-/// A postcard output that folds the bytes into a digest instead of storing them.
+/// A `Hasher` that folds the bytes into the FNV-1a digest.
 #[cfg(feature = "snapshot")]
-struct DigestFlavor(crate::digest::Fnv1a);
+struct DigestHasher(crate::digest::Fnv1a);
 
 #[cfg(feature = "snapshot")]
-impl postcard::ser_flavors::Flavor for DigestFlavor {
-    type Output = u32;
-    fn try_push(&mut self, byte: u8) -> postcard::Result<()> {
-        self.0.push_byte(byte);
-        Ok(())
+impl core::hash::Hasher for DigestHasher {
+    fn write(&mut self, bytes: &[u8]) {
+        bytes.iter().for_each(|b| self.0.push_byte(*b));
     }
-    fn finalize(self) -> postcard::Result<u32> {
-        Ok(self.0.value())
+    // Pointer-sized values (lengths, enum discriminants) as 32 bits: host and target agree.
+    fn write_usize(&mut self, i: usize) {
+        self.write(&(i as u32).to_le_bytes());
+    }
+    fn write_isize(&mut self, i: isize) {
+        self.write(&(i as i32).to_le_bytes());
+    }
+    fn finish(&self) -> u64 {
+        u64::from(self.0.value())
     }
 }
 
@@ -502,10 +524,12 @@ impl Monitor {
             .map_err(|_| SnapshotError::BufferFull)
     }
 
-    /// FNV-1a over the settings' bytes: which configuration a saved state belongs with.
+    /// FNV-1a over the settings (`Hash`): which configuration a saved state belongs with.
     pub fn settings_digest(&self) -> u32 {
-        postcard::serialize_with_flavor(&self.settings, DigestFlavor(crate::digest::Fnv1a::new()))
-            .unwrap_or(0)
+        use core::hash::Hash;
+        let mut h = DigestHasher(crate::digest::Fnv1a::new());
+        self.settings.hash(&mut h);
+        h.0.value()
     }
 
     /// The monitor `config` builds, in the state `bytes` (from [`Monitor::save_state`]).

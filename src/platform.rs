@@ -6,6 +6,7 @@
 //! semihosting (`defmt-semihosting`), which QEMU writes to stdout for the xtask to decode.
 
 pub mod meter;
+pub mod ram_flash;
 pub mod session;
 pub mod stack;
 

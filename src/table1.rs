@@ -55,7 +55,10 @@ impl Torque for f32 {
 }
 
 /// The output's motion relative to the pack.
-#[cfg_attr(feature = "snapshot", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(
+    feature = "snapshot",
+    derive(serde::Serialize, serde::Deserialize, Hash)
+)]
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Motion {
     /// Within the stick band (or held): the pack carries the demand.

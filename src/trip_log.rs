@@ -9,7 +9,7 @@ pub mod record;
 pub mod store;
 
 use crate::monitor::{Estimate, Flags, Inputs, Monitor};
-use record::{decode_inputs, encode_inputs, RecordError, INPUT_BYTES};
+use record::{encode_inputs, RecordError, INPUT_BYTES, RESET_AFTER};
 
 /// Inputs the recorder's ring holds by default: 256 (25.6 ms at 10 kHz), so a window holds
 /// 12.9–25.6 ms of inputs before its change (the state at its start makes any length replay).
@@ -20,8 +20,10 @@ pub struct Recorder<const RING: usize = RING_INPUTS> {
     ring: [[u8; INPUT_BYTES]; RING],
     /// Inputs seen so far.
     seen: u32,
-    older: Option<(u32, Monitor)>,
-    newer: Option<(u32, Monitor)>,
+    /// Two copies of the monitor with the input count each was taken at; `newest` is the
+    /// index of the later one.
+    copies: [Option<(u32, Monitor)>; 2],
+    newest: usize,
 }
 
 impl<const RING: usize> Default for Recorder<RING> {
@@ -39,35 +41,67 @@ impl<const RING: usize> Recorder<RING> {
         Recorder {
             ring: [[0; INPUT_BYTES]; RING],
             seen: 0,
-            older: None,
-            newer: None,
+            copies: [None, None],
+            newest: 1,
         }
     }
 
-    /// Before `monitor` steps on `inputs`: a copy of it every [`Self::EVERY`] inputs, and the
-    /// inputs into the ring.
+    /// Before `monitor` steps on `inputs`: [`Self::snapshot_if_due`], then [`Self::push_input`].
     pub fn before_step(&mut self, monitor: &Monitor, inputs: &Inputs) {
+        self.snapshot_if_due(monitor);
+        self.push_input(inputs);
+    }
+
+    /// Between two steps (on a target: after the background work): a copy of the monitor
+    /// every [`Self::EVERY`] inputs.
+    pub fn snapshot_if_due(&mut self, monitor: &Monitor) {
         if self.seen.is_multiple_of(Self::EVERY.max(1)) {
-            self.older = self.newer.take();
-            self.newer = Some((self.seen, monitor.clone()));
+            // The older slot becomes the newest, overwritten in place (no copy on the stack).
+            self.newest = 1 - self.newest.min(1);
+            if let Some(slot) = self.copies.get_mut(self.newest) {
+                match slot {
+                    Some((at, copy)) => {
+                        *at = self.seen;
+                        copy.clone_from(monitor);
+                    }
+                    None => *slot = Some((self.seen, monitor.clone())),
+                }
+            }
         }
+    }
+
+    /// The inputs of the step about to run, into the ring (12 bytes).
+    pub fn push_input(&mut self, inputs: &Inputs) {
         if let Some(slot) = self.ring.get_mut(self.seen as usize % RING.max(1)) {
             *slot = encode_inputs(inputs);
         }
         self.seen = self.seen.wrapping_add(1);
     }
 
+    /// The operator reset the flags after the last step (replayed after it).
+    pub fn mark_reset(&mut self) {
+        let last = self.seen.wrapping_sub(1) as usize % RING.max(1);
+        if let Some(flags) = self.ring.get_mut(last).and_then(|slot| slot.get_mut(10)) {
+            *flags |= RESET_AFTER;
+        }
+    }
+
     /// The window of a change seen on the last step: the monitor where it starts and its
-    /// inputs through the last one.
-    pub fn window(&self) -> Option<(&Monitor, impl ExactSizeIterator<Item = Inputs> + '_)> {
-        let (start, monitor) = self.older.as_ref().or(self.newer.as_ref())?;
+    /// inputs (encoded) through the last one.
+    pub fn window(
+        &self,
+    ) -> Option<(
+        &Monitor,
+        impl ExactSizeIterator<Item = [u8; INPUT_BYTES]> + '_,
+    )> {
+        let older = self.copies.get(1 - self.newest.min(1))?.as_ref();
+        let newer = self.copies.get(self.newest)?.as_ref();
+        let (start, monitor) = older.or(newer)?;
         let from = *start;
         let n = self.seen.wrapping_sub(from) as usize;
         let inputs = (0..n).map(move |k| {
             let at = from.wrapping_add(k as u32) as usize % RING.max(1);
-            self.ring
-                .get(at)
-                .map_or(Inputs::new(0, 0, 0, false), decode_inputs)
+            self.ring.get(at).copied().unwrap_or([0; INPUT_BYTES])
         });
         Some((monitor, inputs))
     }

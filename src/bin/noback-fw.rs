@@ -28,8 +28,12 @@ mod target {
     use cortex_m::peripheral::{syst::SystClkSource, SCB, SYST};
     use cortex_m_rt::{entry, exception};
     use noback::app::Ticker;
+    use noback::monitor::{Estimate, Flags};
+    use noback::platform::ram_flash::RamFlash;
     use noback::platform::session::{self, fail, Deadline, Stream};
     use noback::replay::Streamed;
+    use noback::trip_log::store::Store;
+    use noback::trip_log::Recorder;
 
     /// Board clock under QEMU (Hz): lm3s6965evb 12.5 MHz, mps2-an386 25 MHz.
     #[cfg(not(target_abi = "eabihf"))]
@@ -70,6 +74,43 @@ mod target {
     /// Most SysTick ticks from a tick's start to the end of its handler (deadline use).
     static ISR_TICKS_MAX: AtomicU32 = AtomicU32::new(0);
 
+    struct TripCell(UnsafeCell<Trip>);
+    // SAFETY: the access protocol above gives one context at a time on this single core.
+    #[allow(unsafe_code)]
+    unsafe impl Sync for TripCell {}
+    struct Trip {
+        recorder: Recorder,
+        /// A flag change waiting for PendSV to freeze the recorder: the estimate, the flags before.
+        pending: Option<(Estimate, Flags)>,
+    }
+    static TRIP: TripCell = TripCell(UnsafeCell::new(Trip {
+        recorder: Recorder::new(),
+        pending: None,
+    }));
+    /// Who holds the recorder: SysTick and PendSV while recording; the main loop while frozen
+    /// (a trip to store); PendSV alone while restarting (a fresh recorder from the monitor).
+    static TRIP_STATE: AtomicU8 = AtomicU8::new(RECORDING);
+    const RECORDING: u8 = 0;
+    const FROZEN: u8 = 1;
+    const RESTARTING: u8 = 2;
+    /// Flags after the last stepped tick (SysTick's own).
+    static LAST_FLAGS: AtomicU8 = AtomicU8::new(0);
+    /// Flag changes not recorded: the recorder was busy with the last one or had no copy yet.
+    static TRIPS_DROPPED: AtomicU32 = AtomicU32::new(0);
+    static TRIPS_STORED: AtomicU32 = AtomicU32::new(0);
+
+    /// The trip recorder. SAFETY: the caller holds its turn under [`TripCell`]'s protocol.
+    #[allow(unsafe_code)]
+    unsafe fn trip() -> &'static mut Trip {
+        // SAFETY: one context at a time (the protocol), so this is the only reference.
+        unsafe { &mut *TRIP.0.get() }
+    }
+
+    /// The trip log's region: four 4 KB pages of RAM (QEMU's flash cannot be programmed).
+    const REGION_BYTES: usize = 16 * 1024;
+    const REGION_PAGE: usize = 4 * 1024;
+    type Region = RamFlash<REGION_BYTES, REGION_PAGE>;
+
     /// The alarm output. Under QEMU a plain latch; a board passes its GPIO's `OutputPin`.
     pub struct AlarmPin {
         high: bool,
@@ -103,13 +144,34 @@ mod target {
             session::run_bench(replay, stream, monitor, peripherals.SYST)
         } else {
             let app = Ticker::new(monitor, replay, AlarmPin { high: false });
-            run_realtime(app, stream, peripherals.SYST, peripherals.SCB)
+            run_realtime(
+                app,
+                stream,
+                peripherals.SYST,
+                peripherals.SCB,
+                args.trip_log(),
+            )
         }
     }
 
     /// SysTick at 10 kHz drives the ticks; the main loop refills the sample ring and logs.
     #[allow(unsafe_code)] // the shared application (`Shared`) and PendSV's priority
-    fn run_realtime(app: App, mut stream: Stream, mut syst: SYST, mut scb: SCB) -> ! {
+    fn run_realtime(
+        app: App,
+        mut stream: Stream,
+        mut syst: SYST,
+        mut scb: SCB,
+        trip_log: Option<&core::ffi::CStr>,
+    ) -> ! {
+        let Some(region) = cortex_m::singleton!(: [u8; REGION_BYTES] = [0; REGION_BYTES]) else {
+            fail("the trip log's region is already taken")
+        };
+        let Ok(mut store) = Store::new(Region::new(region), 0..REGION_BYTES as u32) else {
+            fail("the trip log's region is not whole pages")
+        };
+        let Some(buf) = cortex_m::singleton!(: [u8; REGION_PAGE] = [0; REGION_PAGE]) else {
+            fail("the trip record buffer is already taken")
+        };
         // SAFETY: no interrupt is enabled yet: this is the only context.
         unsafe { *APP.0.get() = Some(app) };
         // SAFETY: PendSV at the lowest priority, so SysTick (priority 0) preempts it; no
@@ -121,6 +183,9 @@ mod target {
         syst.enable_interrupt();
         syst.enable_counter();
         loop {
+            if TRIP_STATE.load(Ordering::Acquire) == FROZEN {
+                store_trip(&mut store, buf);
+            }
             let fed = stream.feed();
             // SAFETY: inside a critical section neither handler runs.
             let event =
@@ -140,6 +205,20 @@ mod target {
         while BACKGROUND_DUE.load(Ordering::Acquire) {
             core::hint::spin_loop();
         }
+        if TRIP_STATE.load(Ordering::Acquire) == FROZEN {
+            store_trip(&mut store, buf);
+        }
+        let region = store.into_flash();
+        if let Some(path) = trip_log {
+            if semihosting::fs::write(path, region.bytes()).is_err() {
+                fail("cannot write the trip log's region to the host")
+            }
+        }
+        defmt::info!(
+            "trip-log stored={=u32} dropped={=u32}",
+            TRIPS_STORED.load(Ordering::Relaxed),
+            TRIPS_DROPPED.load(Ordering::Relaxed)
+        );
         let deadline = Deadline {
             isr_max: ISR_TICKS_MAX.load(Ordering::Relaxed),
             background_max: BACKGROUND_TICKS_MAX.load(Ordering::Relaxed),
@@ -149,6 +228,33 @@ mod target {
             session::finish(app, &deadline)
         }
         fail("the application state vanished")
+    }
+
+    /// Writes the frozen trip's record to the store, then has PendSV restart the recorder
+    /// (the inputs it missed while frozen would break the next window).
+    #[allow(unsafe_code)] // the trip recorder (`TripCell`)
+    fn store_trip(store: &mut Store<Region>, buf: &mut [u8]) {
+        // SAFETY: TRIP_STATE is FROZEN: SysTick and PendSV leave the recorder alone.
+        let t = unsafe { trip() };
+        let stored = t.pending.take().is_some_and(|(estimate, before)| {
+            t.recorder
+                .record(buf, &estimate, before)
+                .is_ok_and(|bytes| store.push(bytes).is_ok())
+        });
+        count(if stored {
+            &TRIPS_STORED
+        } else {
+            &TRIPS_DROPPED
+        });
+        TRIP_STATE.store(RESTARTING, Ordering::Release);
+    }
+
+    /// One more (load and store: thumbv6m has no atomic read-modify-write).
+    fn count(counter: &AtomicU32) {
+        counter.store(
+            counter.load(Ordering::Relaxed).wrapping_add(1),
+            Ordering::Relaxed,
+        );
     }
 
     #[exception]
@@ -169,8 +275,12 @@ mod target {
         // SAFETY: BACKGROUND_DUE is clear, so PendSV is not using the application.
         let stepped = unsafe { shared_app() }.is_some_and(|app| {
             let estimate = app.tick(n);
+            if let (Some(e), Some(inputs)) = (estimate, app.last_inputs()) {
+                record_input(&e, &inputs);
+            }
             if reset_every != 0 && tick_no.wrapping_add(1).is_multiple_of(reset_every) {
                 app.reset_flags();
+                record_reset();
             }
             estimate.is_some()
         });
@@ -193,6 +303,40 @@ mod target {
         }
     }
 
+    /// The tick's inputs into the recorder's ring, and a flag change noted for PendSV; a
+    /// change while the recorder is not recording is counted, not recorded.
+    #[allow(unsafe_code)] // the trip recorder (`TripCell`)
+    fn record_input(e: &Estimate, inputs: &noback::monitor::Inputs) {
+        let before = Flags::from_bits(LAST_FLAGS.load(Ordering::Relaxed));
+        LAST_FLAGS.store(e.flags.bits(), Ordering::Relaxed);
+        let changed = e.flags != before;
+        if TRIP_STATE.load(Ordering::Acquire) != RECORDING {
+            if changed {
+                count(&TRIPS_DROPPED);
+            }
+            return;
+        }
+        // SAFETY: RECORDING, and PendSV is not running (BACKGROUND_DUE was clear).
+        let t = unsafe { trip() };
+        t.recorder.push_input(inputs);
+        if changed {
+            if t.pending.is_some() {
+                count(&TRIPS_DROPPED);
+            }
+            t.pending = Some((*e, before));
+        }
+    }
+
+    /// The operator's flag reset after this tick, into the recorder's ring (it replays).
+    #[allow(unsafe_code)] // the trip recorder (`TripCell`)
+    fn record_reset() {
+        if TRIP_STATE.load(Ordering::Acquire) == RECORDING {
+            // SAFETY: RECORDING, and PendSV is not running (BACKGROUND_DUE was clear).
+            unsafe { trip() }.recorder.mark_reset();
+        }
+        LAST_FLAGS.store(0, Ordering::Relaxed);
+    }
+
     /// The monitor's slow-lane work for the last tick, at the lowest priority.
     #[exception]
     #[allow(unsafe_code)] // the shared application (`Shared`)
@@ -203,6 +347,25 @@ mod target {
         // SAFETY: BACKGROUND_DUE is set, so SysTick leaves the application alone.
         if let Some(app) = unsafe { shared_app() } {
             app.background();
+            // SAFETY: RECORDING or RESTARTING, and SysTick leaves the application (and so the
+            // recorder) alone while BACKGROUND_DUE is set.
+            match TRIP_STATE.load(Ordering::Acquire) {
+                RECORDING => {
+                    let t = unsafe { trip() };
+                    if t.pending.is_some() {
+                        TRIP_STATE.store(FROZEN, Ordering::Release);
+                    } else {
+                        t.recorder.snapshot_if_due(app.monitor());
+                    }
+                }
+                RESTARTING => {
+                    let t = unsafe { trip() };
+                    t.recorder = Recorder::new();
+                    t.recorder.snapshot_if_due(app.monitor());
+                    TRIP_STATE.store(RECORDING, Ordering::Release);
+                }
+                _ => {}
+            }
         }
         if !SCB::is_pendst_pending() {
             record_max(&BACKGROUND_TICKS_MAX);

@@ -38,7 +38,10 @@ use envelope::Envelope;
 use hold::HoldChecks;
 
 /// The checks' constants.
-#[cfg_attr(feature = "snapshot", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(
+    feature = "snapshot",
+    derive(serde::Serialize, serde::Deserialize, Hash)
+)]
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub(crate) struct CheckSettings {
     persistence_ticks: u32,
@@ -76,7 +79,10 @@ pub(crate) struct CheckInputs {
 }
 
 /// The checks' state.
-#[cfg_attr(feature = "snapshot", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(
+    feature = "snapshot",
+    derive(serde::Serialize, serde::Deserialize, Hash)
+)]
 #[derive(Clone, Copy, Debug)]
 pub(crate) struct Checks {
     weak_ticks: u32,

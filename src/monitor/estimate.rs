@@ -27,7 +27,10 @@ use crate::fx::Q16;
 use fixed::types::U40F24;
 
 /// The estimate's constants.
-#[cfg_attr(feature = "snapshot", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(
+    feature = "snapshot",
+    derive(serde::Serialize, serde::Deserialize, Hash)
+)]
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub(crate) struct EstimateSettings {
     /// Q16 W → U40F24 J per tick.
@@ -44,7 +47,10 @@ impl EstimateSettings {
 }
 
 /// The pack's state at the last classification.
-#[cfg_attr(feature = "snapshot", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(
+    feature = "snapshot",
+    derive(serde::Serialize, serde::Deserialize, Hash)
+)]
 #[derive(Clone, Copy, Debug)]
 pub(crate) struct PackEstimate {
     pub force: Q16,
@@ -140,7 +146,10 @@ pub(crate) fn pack(k: &PackSettings, c: &Classified, i: &PackInputs) -> PackEsti
 
 /// Friction energy: slip power `|T·ω|` integrated in the slow lane over the ticks since its
 /// last sample (a heat estimate; saturating, monotone).
-#[cfg_attr(feature = "snapshot", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(
+    feature = "snapshot",
+    derive(serde::Serialize, serde::Deserialize, Hash)
+)]
 #[derive(Clone, Copy, Debug)]
 pub(crate) struct Energy {
     pub joules: U40F24,

@@ -8,7 +8,10 @@ use crate::fx::Q16;
 use fixed::types::U40F24;
 
 /// The raw readings of one tick.
-#[cfg_attr(feature = "snapshot", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(
+    feature = "snapshot",
+    derive(serde::Serialize, serde::Deserialize, Hash)
+)]
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct Inputs {
     /// Phase-current ADC code, offset binary (mid-scale = 0 A). Codes above the converter's
@@ -45,7 +48,10 @@ impl Inputs {
 }
 
 /// The situation the monitor recognised; it selects the model used in the step.
-#[cfg_attr(feature = "snapshot", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(
+    feature = "snapshot",
+    derive(serde::Serialize, serde::Deserialize, Hash)
+)]
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 #[repr(u8)]
 pub enum Scene {
@@ -74,7 +80,10 @@ pub enum Scene {
 ///     SceneModel::ReducedI16F16Euler { rate_hz: 1000 }
 /// );
 /// ```
-#[cfg_attr(feature = "snapshot", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(
+    feature = "snapshot",
+    derive(serde::Serialize, serde::Deserialize, Hash)
+)]
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum SceneModel {
     /// No state to advance: the output at rest under the pack (holding) or at the drive's
@@ -103,7 +112,10 @@ impl core::fmt::Display for SceneModel {
 }
 
 /// State of the friction pack.
-#[cfg_attr(feature = "snapshot", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(
+    feature = "snapshot",
+    derive(serde::Serialize, serde::Deserialize, Hash)
+)]
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 #[repr(u8)]
 pub enum BrakeState {
@@ -117,7 +129,10 @@ pub enum BrakeState {
 
 /// Failure flags. In [`Estimate::flags`] they are latched: once raised they stay until
 /// `Monitor::reset_flags`.
-#[cfg_attr(feature = "snapshot", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(
+    feature = "snapshot",
+    derive(serde::Serialize, serde::Deserialize, Hash)
+)]
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct Flags {
     /// The output moved beyond the creep limit with the drive off after the brake had locked.
@@ -170,8 +185,9 @@ impl Flags {
 
     /// Whether a brake or sensor fault is raised (every flag but `overrun`, which says a tick
     /// was missed, not that the plant or a sensor is other than the model).
-    pub const fn fault(self) -> bool {
-        self.bits() & 0b1111 != 0
+    #[inline]
+    pub const fn fault(&self) -> bool {
+        self.brake_slip | self.brake_weak | self.brake_drag | self.sensor_fault
     }
 
     /// Flags raised in `self` or `other`.
@@ -192,7 +208,10 @@ pub const ESTIMATE_WORDS: usize = 14;
 
 /// The monitor's output for one tick. Signs follow the output shaft: positive = the direction
 /// in which a positive load torque turns it.
-#[cfg_attr(feature = "snapshot", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(
+    feature = "snapshot",
+    derive(serde::Serialize, serde::Deserialize, Hash)
+)]
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct Estimate {
     /// Tick counter (wraps after 2^32 ticks, 5 days at 10 kHz).

@@ -19,7 +19,10 @@ use crate::fx::{lowpass, Gain, Q16};
 const HEALTH_MAX: i32 = 2 << 16;
 
 /// The load stage's constants.
-#[cfg_attr(feature = "snapshot", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(
+    feature = "snapshot",
+    derive(serde::Serialize, serde::Deserialize, Hash)
+)]
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub(crate) struct LoadSettings {
     /// Gain of the load filter, run in the slow lane.
@@ -57,7 +60,10 @@ impl LoadSettings {
 
 /// The load estimate: learning (from zero at power-on) until the filter has run three time
 /// constants, then known; held with the drive off.
-#[cfg_attr(feature = "snapshot", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(
+    feature = "snapshot",
+    derive(serde::Serialize, serde::Deserialize, Hash)
+)]
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub(crate) enum LoadEstimate {
     Learning(Q16),
@@ -83,7 +89,10 @@ impl LoadEstimate {
 
 /// Capacity, reciprocal and margin floor for one load value, recomputed when it changes;
 /// `available` and `margin` for one health value.
-#[cfg_attr(feature = "snapshot", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(
+    feature = "snapshot",
+    derive(serde::Serialize, serde::Deserialize, Hash)
+)]
 #[derive(Clone, Copy, Debug)]
 pub(crate) struct LoadCache {
     load: Q16,
@@ -100,7 +109,10 @@ pub(crate) struct LoadCache {
 }
 
 /// The load stage's state.
-#[cfg_attr(feature = "snapshot", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(
+    feature = "snapshot",
+    derive(serde::Serialize, serde::Deserialize, Hash)
+)]
 #[derive(Clone, Copy, Debug)]
 pub(crate) struct Load {
     pub estimate: LoadEstimate,

@@ -16,7 +16,10 @@ use super::sense::{times, SenseSettings, Sensed};
 use crate::fx::{counter_delta, Q16};
 
 /// The observer stage's constants.
-#[cfg_attr(feature = "snapshot", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(
+    feature = "snapshot",
+    derive(serde::Serialize, serde::Deserialize, Hash)
+)]
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub(crate) struct ObserveSettings {
     pub obs: ObserverScales,
@@ -109,7 +112,10 @@ impl ObserveSettings {
 }
 
 /// What the observer stage hands on.
-#[cfg_attr(feature = "snapshot", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(
+    feature = "snapshot",
+    derive(serde::Serialize, serde::Deserialize, Hash)
+)]
 #[derive(Clone, Copy, Debug)]
 pub(crate) struct Observed {
     /// Output speed ω̂.
@@ -146,7 +152,10 @@ impl Observed {
 
 /// The power-on seeding: after [`POWER_ON_SEED_TICKS`] on-time, plausible ticks the observer
 /// starts from the output's measured speed with its torque balanced, instead of at rest.
-#[cfg_attr(feature = "snapshot", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(
+    feature = "snapshot",
+    derive(serde::Serialize, serde::Deserialize, Hash)
+)]
 #[derive(Clone, Copy, Debug, Default)]
 struct PowerOnSeed {
     /// Ticks left (0: done, or given up).
@@ -156,7 +165,10 @@ struct PowerOnSeed {
 }
 
 /// The observer stage's state.
-#[cfg_attr(feature = "snapshot", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(
+    feature = "snapshot",
+    derive(serde::Serialize, serde::Deserialize, Hash)
+)]
 #[derive(Clone, Copy, Debug)]
 pub(crate) struct Observe {
     obs: Observer,

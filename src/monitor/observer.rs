@@ -16,7 +16,10 @@ use super::convert::{finite, positive, scale, Q16_ONE};
 use super::scale::Scale;
 
 /// The observer's constants (derived in [`ObserverScales::new`]).
-#[cfg_attr(feature = "snapshot", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(
+    feature = "snapshot",
+    derive(serde::Serialize, serde::Deserialize, Hash)
+)]
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub(crate) struct ObserverScales {
     /// Q16 rad/s → angle words per tick (≈ 1.04 by default).
@@ -79,7 +82,10 @@ impl ObserverScales {
 }
 
 /// Observer state.
-#[cfg_attr(feature = "snapshot", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(
+    feature = "snapshot",
+    derive(serde::Serialize, serde::Deserialize, Hash)
+)]
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
 pub(crate) struct Observer {
     /// Angle, 2³² words per turn.

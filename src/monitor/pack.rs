@@ -25,8 +25,20 @@ pub(crate) struct PackRatios {
     pub drive_drag_nm: f64,
 }
 
+/// The ratios' bit patterns (f64 has no `Hash`): a settings digest tells them apart exactly.
+#[cfg(feature = "snapshot")]
+impl core::hash::Hash for PackRatios {
+    fn hash<H: core::hash::Hasher>(&self, h: &mut H) {
+        self.a_k.to_bits().hash(h);
+        self.drive_drag_nm.to_bits().hash(h);
+    }
+}
+
 /// The pack's constants, converted once.
-#[cfg_attr(feature = "snapshot", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(
+    feature = "snapshot",
+    derive(serde::Serialize, serde::Deserialize, Hash)
+)]
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub(crate) struct PackSettings {
     pub spring_force: Q16,
@@ -141,7 +153,10 @@ pub(crate) fn table1(stuck: bool, dir: Dir, demand: Q16, capacity: Q16) -> Q16 {
 }
 
 /// A direction of motion or load: −1, 0 (within a dead band) or +1.
-#[cfg_attr(feature = "snapshot", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(
+    feature = "snapshot",
+    derive(serde::Serialize, serde::Deserialize, Hash)
+)]
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
 pub(crate) struct Dir(i32);
 

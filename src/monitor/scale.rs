@@ -39,7 +39,10 @@ pub enum ScaleError {
 /// assert_eq!(big.apply(1 << 20), i32::MAX); // saturates
 /// assert!(Scale::<30>::from_f64(4.0).is_err()); // 4·2^30 does not fit 31 bits
 /// ```
-#[cfg_attr(feature = "snapshot", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(
+    feature = "snapshot",
+    derive(serde::Serialize, serde::Deserialize, Hash)
+)]
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct Scale<const S: u32> {
     mul: i32,

@@ -26,7 +26,10 @@ use super::{convert::scale, Scene};
 use crate::fx::{counter_delta, Q16};
 
 /// The classifier's constants.
-#[cfg_attr(feature = "snapshot", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(
+    feature = "snapshot",
+    derive(serde::Serialize, serde::Deserialize, Hash)
+)]
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub(crate) struct SceneSettings {
     pub stick_speed: Q16,
@@ -75,7 +78,10 @@ impl SceneSettings {
 }
 
 /// Who carries the load while the drive runs.
-#[cfg_attr(feature = "snapshot", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(
+    feature = "snapshot",
+    derive(serde::Serialize, serde::Deserialize, Hash)
+)]
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub(crate) struct Reading {
     pub overrunning: bool,
@@ -86,7 +92,10 @@ pub(crate) struct Reading {
 }
 
 /// The scene state machine.
-#[cfg_attr(feature = "snapshot", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(
+    feature = "snapshot",
+    derive(serde::Serialize, serde::Deserialize, Hash)
+)]
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub(crate) enum Phase {
     Driving(Reading),
@@ -95,7 +104,10 @@ pub(crate) enum Phase {
 }
 
 /// What classifying hands on.
-#[cfg_attr(feature = "snapshot", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(
+    feature = "snapshot",
+    derive(serde::Serialize, serde::Deserialize, Hash)
+)]
 #[derive(Clone, Copy, Debug)]
 pub(crate) struct Classified {
     pub scene: Scene,
@@ -142,7 +154,10 @@ impl Classified {
 }
 
 /// The classifier's state.
-#[cfg_attr(feature = "snapshot", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(
+    feature = "snapshot",
+    derive(serde::Serialize, serde::Deserialize, Hash)
+)]
 #[derive(Clone, Copy, Debug)]
 pub(crate) struct Classify {
     pub phase: Phase,

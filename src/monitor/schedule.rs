@@ -16,7 +16,10 @@
 //! and persistence counts are those of its own rate: each part counts the ticks it covers.
 
 /// A lane: periodic work every `ticks` ticks (a power of two, so the slot is a mask).
-#[cfg_attr(feature = "snapshot", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(
+    feature = "snapshot",
+    derive(serde::Serialize, serde::Deserialize, Hash)
+)]
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct Lane {
     /// Ticks between two runs.
@@ -43,7 +46,10 @@ pub const SLOW: Lane = Lane { ticks: 4 };
 pub const WINDOW: Lane = Lane { ticks: 16 };
 
 /// What slow-lane work a tick carries.
-#[cfg_attr(feature = "snapshot", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(
+    feature = "snapshot",
+    derive(serde::Serialize, serde::Deserialize, Hash)
+)]
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Slot {
     /// The scene, the load filter (drive on) or pack health (drive off).

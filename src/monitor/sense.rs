@@ -21,7 +21,10 @@ use crate::fx::{lowpass, Gain, Q16};
 const POSITION_HISTORY: usize = 64;
 
 /// The sensors' constants.
-#[cfg_attr(feature = "snapshot", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(
+    feature = "snapshot",
+    derive(serde::Serialize, serde::Deserialize, Hash)
+)]
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub(crate) struct SenseSettings {
     adc_max_code: u16,
@@ -144,7 +147,10 @@ impl SenseSettings {
 }
 
 /// What sensing hands on for one call.
-#[cfg_attr(feature = "snapshot", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(
+    feature = "snapshot",
+    derive(serde::Serialize, serde::Deserialize, Hash)
+)]
 #[derive(Clone, Copy, Debug)]
 pub(crate) struct Sensed {
     /// Ticks covered (1 when on time, ≤ 255).
@@ -187,7 +193,10 @@ impl Sensed {
 }
 
 /// The sensors' memory.
-#[cfg_attr(feature = "snapshot", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(
+    feature = "snapshot",
+    derive(serde::Serialize, serde::Deserialize, Hash)
+)]
 #[derive(Clone, Debug)]
 pub(crate) struct Sense {
     started: bool,

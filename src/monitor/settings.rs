@@ -12,7 +12,10 @@ use super::scene::SceneSettings;
 use super::sense::SenseSettings;
 
 /// Every stage's settings.
-#[cfg_attr(feature = "snapshot", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(
+    feature = "snapshot",
+    derive(serde::Serialize, serde::Deserialize, Hash)
+)]
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub(crate) struct Settings {
     pub sense: SenseSettings,

@@ -1,5 +1,5 @@
 //! What every firmware image under QEMU shares, whatever its board: the semihosting
-//! arguments, the trace it streams from the host, the boot self-check, the bench loop that
+//! arguments (`trace=FILE`, `bench`, `overrun-at=N`, `reset-every=N`, `trip-log=FILE`), the trace it streams from the host, the boot self-check, the bench loop that
 //! counts instructions, and the log lines the xtask decodes (`cargo xtask run` parses them).
 
 use crate::app::{estimate_checksum, Ticker};
@@ -25,6 +25,16 @@ pub struct Args {
     /// Reset the flags after every this many ticks (0: never).
     pub reset_every: u32,
     path: [u8; PATH_BYTES + 1],
+    trip_path: [u8; PATH_BYTES + 1],
+}
+
+impl Args {
+    /// Where to write the trip log's region at the end (`trip-log=FILE`), if asked.
+    pub fn trip_log(&self) -> Option<&core::ffi::CStr> {
+        core::ffi::CStr::from_bytes_until_nul(&self.trip_path)
+            .ok()
+            .filter(|p| !p.is_empty())
+    }
 }
 
 /// Reads the arguments QEMU passed.
@@ -34,6 +44,7 @@ pub fn args() -> Args {
         overrun_at: u32::MAX,
         reset_every: 0,
         path: [0; PATH_BYTES + 1],
+        trip_path: [0; PATH_BYTES + 1],
     };
     if let Ok(args) = semihosting::experimental::env::args::<512>() {
         for arg in args.flatten() {
@@ -43,6 +54,11 @@ pub fn args() -> Args {
                 match a.path.get_mut(..p.len()) {
                     Some(dst) if p.len() <= PATH_BYTES => dst.copy_from_slice(p.as_bytes()),
                     _ => fail("the trace path is too long"),
+                }
+            } else if let Some(p) = arg.strip_prefix("trip-log=") {
+                match a.trip_path.get_mut(..p.len()) {
+                    Some(dst) if p.len() <= PATH_BYTES => dst.copy_from_slice(p.as_bytes()),
+                    _ => fail("the trip log path is too long"),
                 }
             } else if let Some(n) = arg.strip_prefix("overrun-at=") {
                 a.overrun_at = n.parse().unwrap_or(u32::MAX);

@@ -37,8 +37,11 @@ pub enum RecordError {
     State,
 }
 
-/// One input as 12 bytes: the ADC code, both counters whole, the drive command, the ticks
-/// elapsed (a missed deadline replays as it was stepped).
+/// Bit of an input's flags byte: the operator reset the flags after this step.
+pub const RESET_AFTER: u8 = 2;
+
+/// One input as 12 bytes: the ADC code, both counters whole, the drive command (bit 0 of the
+/// flags byte), the ticks elapsed (a missed deadline replays as it was stepped).
 pub fn encode_inputs(i: &Inputs) -> [u8; INPUT_BYTES] {
     let [a0, a1] = i.current_adc_code.to_le_bytes();
     let [m0, m1, m2, m3] = i.motor_counter.to_le_bytes();
@@ -92,12 +95,16 @@ pub struct Record<'a> {
 }
 
 impl<'a> Record<'a> {
-    /// The window's inputs, oldest first; the last is the tick of the change.
-    pub fn inputs(&self) -> impl Iterator<Item = Inputs> + 'a {
+    /// The window's inputs, oldest first (the last is the tick of the change), each with
+    /// whether the operator reset the flags after it.
+    pub fn inputs(&self) -> impl Iterator<Item = (Inputs, bool)> + 'a {
         self.inputs
             .chunks_exact(INPUT_BYTES)
             .filter_map(|c| c.try_into().ok())
-            .map(|c: &[u8; INPUT_BYTES]| decode_inputs(c))
+            .map(|c: &[u8; INPUT_BYTES]| {
+                let [.., flags, _] = *c;
+                (decode_inputs(c), flags & RESET_AFTER != 0)
+            })
     }
 
     /// Inputs in the window.
@@ -110,8 +117,11 @@ impl<'a> Record<'a> {
     pub fn replay(&self, config: crate::monitor::Config) -> Result<Estimate, RecordError> {
         let mut monitor = Monitor::restore(config, self.state).map_err(|_| RecordError::State)?;
         let mut last = None;
-        for i in self.inputs() {
+        for (i, reset) in self.inputs() {
             last = Some(monitor.step(&i));
+            if reset {
+                monitor.reset_flags();
+            }
         }
         last.ok_or(RecordError::NotARecord)
     }
@@ -154,7 +164,7 @@ pub fn encode<'b>(
     start: &Monitor,
     estimate: &Estimate,
     before: Flags,
-    inputs: impl ExactSizeIterator<Item = Inputs>,
+    inputs: impl ExactSizeIterator<Item = [u8; INPUT_BYTES]>,
 ) -> Result<&'b [u8], RecordError> {
     let window = u16::try_from(inputs.len()).map_err(|_| RecordError::BufferFull)?;
     // The state goes after the fixed header, its length back-filled.
@@ -177,7 +187,7 @@ pub fn encode<'b>(
     w.put(&window.to_le_bytes())?;
     w.at += usize::from(state_len);
     for i in inputs {
-        w.put(&encode_inputs(&i))?;
+        w.put(&i)?;
     }
     let sum = checksum(w.buf.get(..w.at).ok_or(RecordError::BufferFull)?);
     w.put(&sum.to_le_bytes())?;

@@ -166,6 +166,13 @@ pub fn replay_report(
     let elf = build(core)?;
     let trace_arg = format!("trace={}", replay_path.display());
     let mut rt_args = vec!["realtime".to_string(), trace_arg.clone()];
+    // The evaluation boards' image writes its trip log's region here at the end.
+    let region = dir.join(format!("{stem}-{}.flash", core.name()));
+    let _ = std::fs::remove_file(&region);
+    let records_trips = core != Core::Stm32f405;
+    if records_trips {
+        rt_args.push(format!("trip-log={}", region.display()));
+    }
     if let Some(n) = overrun_at {
         rt_args.push(format!("overrun-at={n}"));
     }
@@ -288,6 +295,19 @@ pub fn replay_report(
         (serde_json::Value::Null, true)
     };
     let flight_hz = core.flight_clock_hz();
+    // The trip log read back: on a run without operator resets, one record per flag change.
+    let (trip_log, trips_ok) = if records_trips {
+        let bytes = std::fs::read(&region).map_err(|e| format!("{}: {e}", region.display()))?;
+        let (mut v, _) = crate::trip_log::report(bytes, &flags)?;
+        let exact = v["replay_bit_exact"] == true;
+        let ok = exact && (v["matches_flags"] == true || reset_every.is_some());
+        let line = line_with(&realtime.lines, "trip-log")?;
+        v["stored"] = json!(field::<u32>(&line, "stored")?);
+        v["dropped"] = json!(field::<u32>(&line, "dropped")?);
+        (v, ok)
+    } else {
+        (serde_json::Value::Null, true)
+    };
     let report = json!({
         "scene": scene,
         "core": core.name(),
@@ -308,6 +328,7 @@ pub fn replay_report(
         "flight_clock_mhz": flight_hz / 1e6,
         "isr_deadline_pct_at_flight_clock": (1e5 * isr_insns_max * TICK_HZ / flight_hz).round() / 1e3,
         "alarm_pin": alarm_pin,
+        "trip_log": trip_log,
         "deadline_used_pct": (1000.0 * isr_ticks_max / period_ticks).round() / 10.0,
         "deadline_used_with_background_pct": (1000.0 * background_ticks_max / period_ticks).round() / 10.0,
         "flash_bytes": flash_bytes,
@@ -320,7 +341,8 @@ pub fn replay_report(
         "host_digest": format!("{:#010x}", host.totals.digest),
         "key_moments": moments,
     });
-    let ok = realtime.code == 0 && bench.code == 0 && bit_exact && starved == 0 && alarm_ok;
+    let ok =
+        realtime.code == 0 && bench.code == 0 && bit_exact && starved == 0 && alarm_ok && trips_ok;
     Ok((report, ok))
 }
 

@@ -319,6 +319,10 @@ fn run_and_monitor_agree_on_time() -> Result<(), String> {
         .map(|f| (f.flag.to_string(), f.t_s))
         .collect();
     println!("run: {run_flags:?}\nmonitor: {monitor_flags:?}");
+    println!(
+        "trip log read back from the firmware: {}",
+        report["trip_log"]
+    );
     let agree = !run_flags.is_empty()
         && run_flags.len() == monitor_flags.len()
         && run_flags

@@ -160,23 +160,75 @@ fn describe(r: &Record<'_>) -> serde_json::Value {
     })
 }
 
+/// The firmware's region under QEMU: four 4 KB pages of RAM (`src/bin/noback-fw.rs`).
+pub const QEMU_PAGE: usize = 4 * 1024;
+
 /// The records of a region file, oldest first.
 fn read(file: &PathBuf) -> Result<Vec<Vec<u8>>, String> {
     let bytes = std::fs::read(file).map_err(|e| format!("{}: {e}", file.display()))?;
-    if bytes.len() != SECTORS * F405_SECTOR {
-        return Err(format!(
-            "{}: not a trip-log region ({} bytes, expected {})",
-            file.display(),
-            bytes.len(),
-            SECTORS * F405_SECTOR
-        ));
+    read_region(bytes).map_err(|e| format!("{}: {e}", file.display()))
+}
+
+/// The records of a region's bytes, by its size: four 16 KB sectors (`log record`) or four
+/// 4 KB pages (the firmware under QEMU).
+pub fn read_region(bytes: Vec<u8>) -> Result<Vec<Vec<u8>>, String> {
+    match bytes.len() {
+        n if n == SECTORS * F405_SECTOR => read_pages::<F405_SECTOR>(bytes),
+        n if n == SECTORS * QEMU_PAGE => read_pages::<QEMU_PAGE>(bytes),
+        n => Err(format!(
+            "not a trip-log region ({n} bytes, expected {} or {})",
+            SECTORS * F405_SECTOR,
+            SECTORS * QEMU_PAGE
+        )),
     }
-    let mut s = store(Flash::from_bytes(bytes))?;
+}
+
+fn read_pages<const PAGE: usize>(bytes: Vec<u8>) -> Result<Vec<Vec<u8>>, String> {
+    let len = bytes.len() as u32;
+    let mut s =
+        Store::new(SimFlash::<PAGE>::from_bytes(bytes), 0..len).map_err(|e| format!("{e:?}"))?;
     let mut out = Vec::new();
-    let mut buf = vec![0_u8; F405_SECTOR];
+    let mut buf = vec![0_u8; PAGE];
     s.for_each(&mut buf, |item| out.push(item.to_vec()))
-        .map_err(|e| format!("{}: {e:?}", file.display()))?;
+        .map_err(|e| format!("{e:?}"))?;
     Ok(out)
+}
+
+/// The `trip_log` of a run's report: each record's tick, the flags it raised and whether it
+/// replays bit-exact; and whether the raisings equal `flags` (`[{flag, tick}]`).
+pub fn report(
+    region: Vec<u8>,
+    flags: &[serde_json::Value],
+) -> Result<(serde_json::Value, bool), String> {
+    let mut entries = Vec::new();
+    let mut raised = Vec::new();
+    let mut all_exact = true;
+    for bytes in read_region(region)? {
+        let r = decode(&bytes).map_err(|e| format!("trip record: {e:?}"))?;
+        let (exact, _) = replay(&bytes)?;
+        all_exact &= exact;
+        let new = Flags::from_bits(r.now.bits() & !r.before.bits());
+        for name in crate::run::flag_names(new.bits()) {
+            raised.push((name.to_string(), u64::from(r.tick)));
+        }
+        entries.push(json!({
+            "tick": r.tick,
+            "before": names(r.before),
+            "now": names(r.now),
+            "window_inputs": r.window_len(),
+            "replay_bit_exact": exact,
+        }));
+    }
+    let expected: Vec<(String, u64)> = flags
+        .iter()
+        .map(|f| {
+            let name = f["flag"].as_str().unwrap_or("").to_string();
+            (name, f["tick"].as_u64().unwrap_or(0))
+        })
+        .collect();
+    let matches = raised == expected;
+    let v = json!({"records": entries, "matches_flags": matches, "replay_bit_exact": all_exact});
+    Ok((v, matches && all_exact))
 }
 
 /// The records of a host run of `scene` (a record at each flag change) and the region.

@@ -42,7 +42,10 @@ use crate::monitor::pack::PackRatios;
 use crate::monitor::schedule::WINDOW;
 
 /// The dead-reading check's constants.
-#[cfg_attr(feature = "snapshot", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(
+    feature = "snapshot",
+    derive(serde::Serialize, serde::Deserialize, Hash)
+)]
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub(crate) struct DeadCurrentSettings {
     out_bits: u8,
@@ -83,7 +86,10 @@ impl DeadCurrentSettings {
 pub(crate) const BLOCK_WINDOWS: u8 = 8;
 
 /// State of the dead-reading check: the block being summed, and when the pack last held.
-#[cfg_attr(feature = "snapshot", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(
+    feature = "snapshot",
+    derive(serde::Serialize, serde::Deserialize, Hash)
+)]
 #[derive(Clone, Copy, Debug)]
 pub(crate) struct DeadCurrent {
     /// Sum of the drive torque's magnitude over the block's samples (N·m).

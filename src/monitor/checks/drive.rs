@@ -22,7 +22,10 @@ use crate::monitor::schedule::SLOW;
 use crate::monitor::Flags;
 
 /// The drive checks' constants.
-#[cfg_attr(feature = "snapshot", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(
+    feature = "snapshot",
+    derive(serde::Serialize, serde::Deserialize, Hash)
+)]
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub(crate) struct DriveSettings {
     persistence_ticks: u32,
@@ -90,7 +93,10 @@ impl DriveSettings {
 }
 
 /// State of the drive checks.
-#[cfg_attr(feature = "snapshot", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(
+    feature = "snapshot",
+    derive(serde::Serialize, serde::Deserialize, Hash)
+)]
 #[derive(Clone, Copy, Debug, Default)]
 pub(crate) struct DriveChecks {
     /// Ticks the pack has dragged beyond the allowance.

@@ -18,7 +18,10 @@ use crate::monitor::schedule::Slot;
 use crate::monitor::sense::times;
 
 /// The envelope's constants.
-#[cfg_attr(feature = "snapshot", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(
+    feature = "snapshot",
+    derive(serde::Serialize, serde::Deserialize, Hash)
+)]
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub(crate) struct EnvelopeSettings {
     /// Ticks per step of the nominal braking model (`tick_hz / braking_model_hz`).
@@ -91,7 +94,10 @@ fn model_ticks(model_hz: f64, tick_hz: f64) -> Result<u32, ConfigError> {
 }
 
 /// One braking event's envelope (drive cut to lock).
-#[cfg_attr(feature = "snapshot", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(
+    feature = "snapshot",
+    derive(serde::Serialize, serde::Deserialize, Hash)
+)]
 #[derive(Clone, Copy, Debug, Default)]
 pub(crate) struct Envelope {
     /// Output travel since the cut (counts, saturating).
@@ -111,7 +117,10 @@ pub(crate) struct Envelope {
 }
 
 /// What one envelope call reads.
-#[cfg_attr(feature = "snapshot", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(
+    feature = "snapshot",
+    derive(serde::Serialize, serde::Deserialize, Hash)
+)]
 #[derive(Clone, Copy, Debug)]
 pub(crate) struct BrakingTick {
     pub n: u32,

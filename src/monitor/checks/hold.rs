@@ -11,7 +11,10 @@ use crate::monitor::config::{Config, ConfigError};
 use crate::monitor::convert::{counts, positive};
 
 /// The held brake's constants.
-#[cfg_attr(feature = "snapshot", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(
+    feature = "snapshot",
+    derive(serde::Serialize, serde::Deserialize, Hash)
+)]
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub(crate) struct HoldSettings {
     creep_counts: i32,
@@ -32,7 +35,10 @@ impl HoldSettings {
 }
 
 /// The held brake's checks.
-#[cfg_attr(feature = "snapshot", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(
+    feature = "snapshot",
+    derive(serde::Serialize, serde::Deserialize, Hash)
+)]
 #[derive(Clone, Copy, Debug, Default)]
 pub(crate) struct HoldChecks {
     /// The creep span is measured (from the brake's first hold since the drive's cut).

@@ -26,7 +26,10 @@ use crate::monitor::convert::counts;
 
 /// One shaft's monotone excursion: where the current run in one direction started and how far
 /// it has gone.
-#[cfg_attr(feature = "snapshot", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(
+    feature = "snapshot",
+    derive(serde::Serialize, serde::Deserialize, Hash)
+)]
 #[derive(Clone, Copy, Debug, Default)]
 struct Excursion {
     /// Position where the current run started (counts).
@@ -66,7 +69,10 @@ impl Excursion {
 }
 
 /// State of the common-slip check.
-#[cfg_attr(feature = "snapshot", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(
+    feature = "snapshot",
+    derive(serde::Serialize, serde::Deserialize, Hash)
+)]
 #[derive(Clone, Copy, Debug, Default)]
 pub(crate) struct SlipCheck {
     /// Following the shafts (from the brake's first hold after a cut until the drive runs).
@@ -79,7 +85,10 @@ pub(crate) struct SlipCheck {
 }
 
 /// The check's limits, in counts (from the configuration).
-#[cfg_attr(feature = "snapshot", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(
+    feature = "snapshot",
+    derive(serde::Serialize, serde::Deserialize, Hash)
+)]
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub(crate) struct SlipLimits {
     /// Output travel of a common run beyond which the pack slips.
