@@ -290,7 +290,7 @@ impl Monitor {
         st.fault_latched |= raised.fault();
         st.slow = SlowResult::NONE;
         self.job_due = true;
-        st.report(o)
+        st.report(o, k.commissioned)
     }
 
     /// The slow lane's work for the last [`Monitor::tick`] (one slot of classify, estimate,
@@ -400,7 +400,11 @@ impl State {
         if x.drive && !x.drive_edge && WINDOW.slot(self.tick) == 0 && self.load.cache_stale(load) {
             self.refresh_load(k);
         }
-        if moving_ok && !x.drive && self.load.estimate.known().is_some() {
+        // Against an opposing load the load itself slows the output: the pack's torque there
+        // is known only where both socket faces clamp (`learn_opposed`).
+        let learnable = self.load.estimate.known().is_some()
+            && (k.load.learn_opposed || Dir::of(load, k.scene.min_load) == c.dir);
+        if moving_ok && !x.drive && learnable {
             let measured = load.saturating_sub(o.net);
             self.load.learn_health(&k.load, c.dir.apply(measured));
         }
@@ -469,11 +473,12 @@ impl State {
 
     /// The estimate of this tick: the last classification's, with this tick's count, energy,
     /// trust and flags.
-    fn report(&self, o: &Observed) -> Estimate {
+    fn report(&self, o: &Observed, commissioned: bool) -> Estimate {
         Estimate {
             tick: self.tick,
             friction_energy_j: self.energy.joules,
-            trusted: self.load.estimate.known().is_some()
+            trusted: commissioned
+                && self.load.estimate.known().is_some()
                 && o.settled
                 && o.sensors_ok
                 && o.in_time

@@ -23,7 +23,7 @@ fn main() {
     let mut args = std::env::args().skip(1);
     let runs: u64 = args.next().and_then(|a| a.parse().ok()).unwrap_or(2000);
     let seed: u64 = args.next().and_then(|a| a.parse().ok()).unwrap_or(2026);
-    let config = Config::default();
+    let config = Config::physical_reading();
     let s: SensorConfig = config.sensors;
     let nm_per_code = s.input_torque_nm(s.amps_per_count());
     let mid = f64::from(1_u32 << (s.current_adc_bits - 1));

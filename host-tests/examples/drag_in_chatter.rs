@@ -76,7 +76,7 @@ fn main() -> Result<(), String> {
     let mut args = std::env::args().skip(1);
     let runs: u64 = args.next().and_then(|a| a.parse().ok()).unwrap_or(500);
     let seed: u64 = args.next().and_then(|a| a.parse().ok()).unwrap_or(2026);
-    let config = Config::default();
+    let config = Config::physical_reading();
     let (mut manifested, mut detected, mut cc_missed, mut in_time) = (0, 0, 0, 0);
     println!(
         "drag misses in continuous closing (seed {seed}): means over the 50 ms after the \

@@ -8,8 +8,7 @@
 
 use host_tests::accuracy::{compare, run_monitor};
 use host_tests::family::{form, Family};
-use host_tests::mc::{draw_in, draw_trace};
-use noback::monitor::Config;
+use host_tests::mc::{draw_in, draw_trace, not_driven};
 use std::collections::BTreeMap;
 
 fn main() -> Result<(), String> {
@@ -29,11 +28,16 @@ fn main() -> Result<(), String> {
         let key = format!("{} {:?}", form(&d.scene), d.scene.kind);
         *runs_by.entry(key.clone()).or_default() += 1;
         let trace = draw_trace(&d)?;
-        let acc = compare(&trace, &run_monitor(&trace, Config::default())?);
+        let acc = compare(&trace, &run_monitor(&trace, Family::Plant.config())?);
         if let Some(f) = acc.flags.first() {
             let mu = d.scene.open.paper_sliding_mu_static;
+            let apart = if not_driven(&trace) {
+                ", not driven: apart"
+            } else {
+                ""
+            };
             *flags_by
-                .entry(format!("{key}: {} (sliding μ_s {mu})", f.flag))
+                .entry(format!("{key}: {} (sliding μ_s {mu}{apart})", f.flag))
                 .or_default() += 1;
         }
     }

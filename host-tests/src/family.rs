@@ -4,6 +4,7 @@
 //! docs/model.md ("The plant family"); the `physical-default` family keeps the physical reading
 //! with its defaults (Table 2 ± 10 % is drawn in both).
 
+use noback::monitor::Config;
 use noback_twin::reading::Reading;
 use noback_twin::scene::Scene;
 use noback_twin::sensing::Rng;
@@ -26,6 +27,15 @@ impl Family {
         match self {
             Family::PhysicalDefault => "physical-default",
             Family::Plant => "plant",
+        }
+    }
+
+    /// The monitor a campaign of this family runs: the physical reading's own settings on its
+    /// plant, the uncommissioned defaults on the whole family.
+    pub fn config(self) -> Config {
+        match self {
+            Family::PhysicalDefault => Config::physical_reading(),
+            Family::Plant => Config::default(),
         }
     }
 

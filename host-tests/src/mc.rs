@@ -65,6 +65,33 @@ pub struct Outcome {
     pub false_flags: usize,
     /// The twin failed to run this draw (reported, never silently dropped).
     pub error: Option<String>,
+    /// A nominal draw whose plant does not move its output while driven ([`not_driven`]):
+    /// counted apart from the false alarms, whatever the monitor raised.
+    pub not_driven: bool,
+}
+
+/// Input travel (rad, output side) with the output encoder standing still and the drive on
+/// beyond which a draw's plant is not driving its door: a jammed or decoupled actuator, which
+/// a monitor should flag. Healthy draws of both readings stay below 0.13 rad (seed 1616).
+pub const NOT_DRIVEN_RAD: f64 = 1.0;
+
+/// Whether the trace's drive turns its input by [`NOT_DRIVEN_RAD`] with the output still.
+pub fn not_driven(trace: &Trace) -> bool {
+    let (mut travel, mut out) = (0.0, None);
+    let mut prev_t = trace.rows.first().map_or(0.0, |r| r.t_s);
+    for r in &trace.rows {
+        let dt = r.t_s - prev_t;
+        prev_t = r.t_s;
+        if !r.drive_on || out != Some(r.output_count) {
+            (travel, out) = (0.0, Some(r.output_count));
+        } else {
+            travel += (r.input_speed_rad_s * dt).abs();
+            if travel > NOT_DRIVEN_RAD {
+                return true;
+            }
+        }
+    }
+    false
 }
 
 /// When, after power-on into a running drive, the drive checks have a history to judge a
@@ -320,12 +347,20 @@ pub struct Campaign {
     pub pre_roll_s: f64,
 }
 
-impl Default for Campaign {
-    fn default() -> Self {
+impl Campaign {
+    /// The campaign of a plant family, with the monitor [`Family::config`] gives it.
+    pub fn for_family(family: Family) -> Campaign {
         Campaign {
-            config: Config::default(),
+            config: family.config(),
             pre_roll_s: PRE_ROLL_S,
         }
+    }
+}
+
+impl Default for Campaign {
+    /// The default family's campaign.
+    fn default() -> Self {
+        Campaign::for_family(Family::PhysicalDefault)
     }
 }
 
@@ -339,6 +374,7 @@ pub fn evaluate(d: &Draw, campaign: &Campaign) -> Outcome {
         context: None,
         false_flags: 0,
         error: Some(e),
+        not_driven: false,
     };
     let trace = match draw_trace_after(d, campaign.pre_roll_s) {
         Ok(trace) => trace,
@@ -359,6 +395,7 @@ pub fn evaluate(d: &Draw, campaign: &Campaign) -> Outcome {
         context: fault.map(|f| Context::of(f.at_s, &trace, d.scene.kind, &campaign.config)),
         false_flags: acc.flags.iter().filter(|f| f.t_s < onset).count(),
         error: None,
+        not_driven: fault.is_none() && not_driven(&trace),
     }
 }
 

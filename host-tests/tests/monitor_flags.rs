@@ -18,7 +18,7 @@ fn at_rest(monitor: &mut Monitor, out: u32, motor: u32, ticks: u32) -> Estimate 
 
 #[test]
 fn power_on_at_rest_locks_without_flags() {
-    let mut m = Monitor::new(Config::default()).unwrap();
+    let mut m = Monitor::new(Config::physical_reading()).unwrap();
     let e = at_rest(&mut m, 1234, 555, 500);
     assert_eq!(e.brake, BrakeState::Locked);
     assert_eq!(e.scene, Scene::Holding);
@@ -30,7 +30,7 @@ fn power_on_at_rest_locks_without_flags() {
 
 #[test]
 fn out_of_range_adc_code_latches_sensor_fault_until_reset() {
-    let mut m = Monitor::new(Config::default()).unwrap();
+    let mut m = Monitor::new(Config::physical_reading()).unwrap();
     at_rest(&mut m, 0, 0, 100);
     let e = m.step(&Inputs::new(4096, 0, 0, false)); // a 12-bit ADC cannot produce it
     assert!(e.flags.sensor_fault);
@@ -49,11 +49,12 @@ fn out_of_range_adc_code_latches_sensor_fault_until_reset() {
 
 #[test]
 fn adc_stuck_at_a_rail_is_a_sensor_fault_but_a_single_rail_sample_is_not() {
-    let mut m = Monitor::new(Config::default()).unwrap();
+    let mut m = Monitor::new(Config::physical_reading()).unwrap();
     at_rest(&mut m, 0, 0, 100);
     // The rail must last `adc_rail_time_s` (10 ms: the motor stalls at the current limit for
     // ≈ 3 ms in overrunning chatter, reading the rail with the encoder still).
-    let rail_ticks = (Config::default().thresholds.adc_rail_time_s * 10_000.0).round() as usize;
+    let rail_ticks =
+        (Config::physical_reading().thresholds.adc_rail_time_s * 10_000.0).round() as usize;
     for k in 1..rail_ticks {
         let e = m.step(&Inputs::new(0, 0, 0, true));
         assert!(!e.flags.sensor_fault, "after {k} ticks at the rail");
@@ -64,12 +65,12 @@ fn adc_stuck_at_a_rail_is_a_sensor_fault_but_a_single_rail_sample_is_not() {
 
 #[test]
 fn current_with_the_drive_off_is_implausible() {
-    let mut m = Monitor::new(Config::default()).unwrap();
+    let mut m = Monitor::new(Config::physical_reading()).unwrap();
     at_rest(&mut m, 0, 0, 100);
     // 5 A with the drive off (3 A allowed): 5/(50/4096) ≈ 410 counts.
     let e = m.step(&Inputs::new(MID + 410, 0, 0, false));
     assert!(e.flags.sensor_fault);
-    let mut m = Monitor::new(Config::default()).unwrap();
+    let mut m = Monitor::new(Config::physical_reading()).unwrap();
     at_rest(&mut m, 0, 0, 100);
     let e = m.step(&Inputs::new(MID + 200, 0, 0, false)); // 2.4 A: within the allowance
     assert!(!e.flags.sensor_fault);
@@ -78,7 +79,7 @@ fn current_with_the_drive_off_is_implausible() {
 #[test]
 fn output_encoder_wrap_is_motion_not_a_jump() {
     // Creep across the 14-bit wrap at 0.77 rad/s (2 counts every 10 ticks) with the drive on.
-    let mut m = Monitor::new(Config::default()).unwrap();
+    let mut m = Monitor::new(Config::physical_reading()).unwrap();
     let mut out: u32 = 16_300;
     let mut motor: u32 = 65_000;
     let mut e = m.step(&Inputs::new(MID, motor, out, true));
@@ -106,7 +107,7 @@ fn output_encoder_wrap_is_motion_not_a_jump() {
 
 #[test]
 fn output_encoder_jump_is_a_sensor_fault_and_a_glitch_leaves_no_brake_flag() {
-    let mut m = Monitor::new(Config::default()).unwrap();
+    let mut m = Monitor::new(Config::physical_reading()).unwrap();
     at_rest(&mut m, 8000, 0, 2000);
     // One corrupted sample 3000 counts away, then back.
     let e = m.step(&Inputs::new(MID, 0, 11_000, false));
@@ -125,14 +126,14 @@ fn output_encoder_jump_is_a_sensor_fault_and_a_glitch_leaves_no_brake_flag() {
 
 #[test]
 fn counter_bits_above_the_register_width_are_implausible() {
-    let mut m = Monitor::new(Config::default()).unwrap();
+    let mut m = Monitor::new(Config::physical_reading()).unwrap();
     at_rest(&mut m, 0, 0, 10);
     assert!(
         m.step(&Inputs::new(MID, 0, 1 << 14, false))
             .flags
             .sensor_fault
     );
-    let mut m = Monitor::new(Config::default()).unwrap();
+    let mut m = Monitor::new(Config::physical_reading()).unwrap();
     at_rest(&mut m, 0, 0, 10);
     assert!(
         m.step(&Inputs::new(MID, 1 << 16, 0, false))
@@ -144,7 +145,7 @@ fn counter_bits_above_the_register_width_are_implausible() {
 #[test]
 fn stuck_output_encoder_while_driving_is_detected() {
     // Drive on, motor turning at 100 rad/s motor side, output counter frozen.
-    let mut m = Monitor::new(Config::default()).unwrap();
+    let mut m = Monitor::new(Config::physical_reading()).unwrap();
     let mut motor: u32 = 0;
     let mut e = m.step(&Inputs::new(MID + 100, motor, 5, true));
     for _ in 0..20_000 {
@@ -161,7 +162,7 @@ fn stuck_output_encoder_while_driving_is_detected() {
 
 #[test]
 fn missed_tick_latches_overrun() {
-    let mut m = Monitor::new(Config::default()).unwrap();
+    let mut m = Monitor::new(Config::physical_reading()).unwrap();
     at_rest(&mut m, 0, 0, 200);
     let late = Inputs {
         ticks_elapsed: 3,
@@ -186,7 +187,7 @@ fn missed_tick_latches_overrun() {
 
 #[test]
 fn very_late_step_reseats_the_observer_and_is_untrusted() {
-    let mut m = Monitor::new(Config::default()).unwrap();
+    let mut m = Monitor::new(Config::physical_reading()).unwrap();
     at_rest(&mut m, 100, 0, 200);
     let e = m.step(&Inputs {
         ticks_elapsed: 200,
@@ -203,7 +204,7 @@ fn missed_ticks_while_moving_keep_tracking() {
     // carries ≈ 3 N·m (150 ADC counts): a moving no-back's drive always carries some, and a
     // reading of zero while the output turns is a dead current sensor (`sensor_fault`).
     let code = MID + 150;
-    let mut m = Monitor::new(Config::default()).unwrap();
+    let mut m = Monitor::new(Config::physical_reading()).unwrap();
     let (mut out, mut motor) = (0_u32, 0_u32);
     let mut e = m.step(&Inputs::new(code, motor, out, true));
     for k in 0..4000_u32 {
@@ -223,7 +224,7 @@ fn missed_ticks_while_moving_keep_tracking() {
 
 #[test]
 fn estimate_words_round_trip_the_fields() {
-    let mut m = Monitor::new(Config::default()).unwrap();
+    let mut m = Monitor::new(Config::physical_reading()).unwrap();
     let e = at_rest(&mut m, 77, 0, 300);
     let w = e.to_words();
     assert_eq!(w.len(), ESTIMATE_WORDS);
@@ -244,7 +245,7 @@ fn err(config: Config) -> ConfigError {
 
 #[test]
 fn constructor_rejects_non_finite_parameters() {
-    let mut c = Config::default();
+    let mut c = Config::physical_reading();
     c.mechanism.socket_radius_m = f64::NAN;
     assert_eq!(
         err(c),
@@ -252,7 +253,7 @@ fn constructor_rejects_non_finite_parameters() {
             parameter: "mechanism.socket_radius_m"
         }
     );
-    let mut c = Config::default();
+    let mut c = Config::physical_reading();
     c.thresholds.creep_limit_rad = f64::INFINITY;
     assert_eq!(
         err(c),
@@ -264,7 +265,7 @@ fn constructor_rejects_non_finite_parameters() {
 
 #[test]
 fn constructor_rejects_out_of_range_parameters() {
-    let mut c = Config::default();
+    let mut c = Config::physical_reading();
     c.mechanism.output_inertia_kg_m2 = -0.15;
     assert_eq!(
         err(c),
@@ -272,7 +273,7 @@ fn constructor_rejects_out_of_range_parameters() {
             parameter: "mechanism.output_inertia_kg_m2"
         }
     );
-    let mut c = Config::default();
+    let mut c = Config::physical_reading();
     c.sensors.reducer_efficiency = 1.2;
     assert_eq!(
         err(c),
@@ -281,7 +282,7 @@ fn constructor_rejects_out_of_range_parameters() {
         }
     );
     // A seeded power-on settles sooner than the observer's full settling, never later.
-    let mut c = Config::default();
+    let mut c = Config::physical_reading();
     c.thresholds.power_on_settle_s = c.thresholds.settle_time_s + 0.01;
     assert_eq!(
         err(c),
@@ -292,7 +293,7 @@ fn constructor_rejects_out_of_range_parameters() {
     // A dead current reading is one well below the spring drag a moving no-back's drive
     // carries (1.98 N·m with Table 2): a threshold at or above it would call healthy drives
     // dead.
-    let mut c = Config::default();
+    let mut c = Config::physical_reading();
     c.thresholds.dead_current_nm = 2.0;
     assert_eq!(
         err(c),
@@ -300,7 +301,7 @@ fn constructor_rejects_out_of_range_parameters() {
             parameter: "thresholds.dead_current_nm"
         }
     );
-    let mut c = Config::default();
+    let mut c = Config::physical_reading();
     c.thresholds.dead_current_speed_rad_s = 0.0;
     assert_eq!(
         err(c),
@@ -308,7 +309,7 @@ fn constructor_rejects_out_of_range_parameters() {
             parameter: "thresholds.dead_current_speed_rad_s"
         }
     );
-    let mut c = Config::default();
+    let mut c = Config::physical_reading();
     c.thresholds.impact_time_s = 0.0;
     assert_eq!(
         err(c),
@@ -319,7 +320,7 @@ fn constructor_rejects_out_of_range_parameters() {
     // μ_d·c·k = 1 would make the overrunning equilibrium singular (0.17 gives 1.42).
     let c = Config {
         sliding_mu: 0.17 / 1.417,
-        ..Config::default()
+        ..Config::physical_reading()
     };
     assert_eq!(
         err(c),
@@ -327,7 +328,7 @@ fn constructor_rejects_out_of_range_parameters() {
             parameter: "sliding_mu"
         }
     );
-    let mut c = Config::default();
+    let mut c = Config::physical_reading();
     c.sensors.output_encoder_bits = 30;
     assert_eq!(
         err(c),
@@ -337,7 +338,7 @@ fn constructor_rejects_out_of_range_parameters() {
     );
     // The common-slip check measures travel on the wrapping counters: a limit of a quarter
     // turn of the 14-bit output encoder (1.57 rad) or beyond cannot be resolved.
-    let mut c = Config::default();
+    let mut c = Config::physical_reading();
     c.thresholds.slip_output_travel_rad = 1.6;
     assert_eq!(
         err(c),
@@ -345,7 +346,7 @@ fn constructor_rejects_out_of_range_parameters() {
             parameter: "thresholds.slip_output_travel_rad"
         }
     );
-    let mut c = Config::default();
+    let mut c = Config::physical_reading();
     c.thresholds.slip_input_travel_rad = -0.045;
     assert_eq!(
         err(c),
@@ -353,7 +354,7 @@ fn constructor_rejects_out_of_range_parameters() {
             parameter: "thresholds.slip_input_travel_rad"
         }
     );
-    let mut c = Config::default();
+    let mut c = Config::physical_reading();
     c.thresholds.undecelerated_allowance_rad = 0.0;
     assert_eq!(
         err(c),
@@ -362,7 +363,7 @@ fn constructor_rejects_out_of_range_parameters() {
         }
     );
     // Just inside the quarter turn: accepted.
-    let mut c = Config::default();
+    let mut c = Config::physical_reading();
     c.thresholds.slip_output_travel_rad = 1.5;
     assert!(noback::monitor::Monitor::new(c).is_ok());
 }
@@ -370,7 +371,7 @@ fn constructor_rejects_out_of_range_parameters() {
 #[test]
 fn constructor_rejects_formats_that_would_overflow() {
     // A 0.2 mm socket radius makes the ramp force of 60 N·m 300 kN: beyond Q16.
-    let mut c = Config::default();
+    let mut c = Config::physical_reading();
     c.mechanism.socket_radius_m = 0.0002;
     assert_eq!(
         err(c),
@@ -379,7 +380,7 @@ fn constructor_rejects_formats_that_would_overflow() {
         }
     );
     // A 100 kA current sensor: drive torque beyond Q16.
-    let mut c = Config::default();
+    let mut c = Config::physical_reading();
     c.sensors.current_full_scale_a = 100_000.0;
     assert_eq!(
         err(c),
@@ -388,7 +389,7 @@ fn constructor_rejects_formats_that_would_overflow() {
         }
     );
     // A 10-bit motor counter aliases at 1800 rad/s over 8 late ticks.
-    let mut c = Config::default();
+    let mut c = Config::physical_reading();
     c.sensors.motor_counter_bits = 10;
     assert_eq!(
         err(c),
@@ -406,7 +407,7 @@ fn constructor_rejects_an_unstable_observer() {
             speed_per_s: 10.0,
             accel_per_s2: 10.0,
         },
-        ..Config::default()
+        ..Config::physical_reading()
     };
     assert_eq!(
         err(c),
@@ -424,7 +425,7 @@ fn constructor_rejects_an_unstable_observer() {
     assert!(gains.is_stable(1e-4) && gains.is_stable(5e-4) && !gains.is_stable(6e-4));
     let mut c = Config {
         observer: gains,
-        ..Config::default()
+        ..Config::physical_reading()
     };
     assert_eq!(
         err(c),
@@ -437,7 +438,7 @@ fn constructor_rejects_an_unstable_observer() {
     // A slower tick with the same gains: outside the stability region.
     let c = Config {
         tick_hz: 1_000.0,
-        ..Config::default()
+        ..Config::physical_reading()
     };
     assert_eq!(
         err(c),
@@ -453,7 +454,7 @@ fn constructor_rejects_gains_beyond_their_format() {
     // ∝ bandwidth³, its Scale<33>; the first one checked is named).
     let c = Config {
         observer: ObserverGains::triple_pole(300.0, 10_000.0),
-        ..Config::default()
+        ..Config::physical_reading()
     };
     assert_eq!(
         err(c),
@@ -464,7 +465,7 @@ fn constructor_rejects_gains_beyond_their_format() {
     // A 3 Hz one: l₂ would keep fewer than 20 significant bits in its Scale<36>.
     let c = Config {
         observer: ObserverGains::triple_pole(3.0, 10_000.0),
-        ..Config::default()
+        ..Config::physical_reading()
     };
     assert_eq!(
         err(c),
@@ -492,12 +493,12 @@ fn errors_name_their_parameter_in_the_message() {
 /// drive").
 #[test]
 fn power_on_into_a_running_drive_seeds_the_observer_speed_unless_a_tick_is_late() {
-    let sensors = Config::default().sensors;
+    let sensors = Config::physical_reading().sensors;
     let out_per_tick = 3_u32; // 3 counts a tick: 11.5 rad/s
     let speed = f64::from(out_per_tick) * sensors.output_rad_per_count() * 10_000.0;
     let motor_per_out = sensors.output_rad_per_count() / sensors.input_rad_per_motor_count();
     let speed_after = |late_at: Option<u32>| {
-        let mut m = Monitor::new(Config::default()).unwrap();
+        let mut m = Monitor::new(Config::physical_reading()).unwrap();
         let mut e = None;
         let mut ticks = 0_u32;
         // The estimate is the slow lane's snapshot: one slow period more before it shows.

@@ -66,7 +66,7 @@ proptest! {
         for n in 1..=8 {
             prop_assert!(g.is_stable(f64::from(n) * 1e-4), "{} Hz at {} ticks", bandwidth, n);
         }
-        let c = Config { observer: g, ..Config::default() };
+        let c = Config { observer: g, ..Config::physical_reading() };
         prop_assert!(Monitor::new(c).is_ok());
     }
 }
@@ -150,7 +150,7 @@ proptest! {
 
     #[test]
     fn any_stream_never_panics_and_stays_bounded(ticks in stream()) {
-        let mut m = Monitor::new(Config::default()).unwrap();
+        let mut m = Monitor::new(Config::physical_reading()).unwrap();
         let mut prev: Option<Estimate> = None;
         for t in &ticks {
             let inputs = Inputs {
@@ -178,7 +178,7 @@ proptest! {
     #[test]
     fn reset_clears_and_same_stream_gives_same_bits(ticks in stream()) {
         let run = |ticks: &[Tick]| {
-            let mut m = Monitor::new(Config::default()).unwrap();
+            let mut m = Monitor::new(Config::physical_reading()).unwrap();
             let mut words = Vec::new();
             for t in ticks {
                 let e = m.step(&Inputs {

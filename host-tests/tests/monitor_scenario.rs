@@ -250,7 +250,7 @@ fn dump(trace: &[(f64, f64, Estimate)], name: &str) {
 
 fn check_paper_case(load: f64, speed: f64, name: &str) {
     let mut plant = Plant::new(load, speed);
-    let mut monitor = Monitor::new(Config::default()).unwrap();
+    let mut monitor = Monitor::new(Config::physical_reading()).unwrap();
     let trace = run(&mut plant, &mut monitor, speed, 0.2, 0.7);
     let last = trace.last().unwrap().2;
     dump(&trace, name);
@@ -279,7 +279,7 @@ fn check_paper_case(load: f64, speed: f64, name: &str) {
     // integrates the true pack torque over the true travel. Compared from the end of the
     // observer's settling (power-on while moving: the monitor keeps the cheap drive-carries
     // reading, untrusted, until then).
-    let settle = (Config::default().thresholds.settle_time_s * TICK_HZ).round() as usize;
+    let settle = (Config::physical_reading().thresholds.settle_time_s * TICK_HZ).round() as usize;
     let energy =
         last.friction_energy_j.to_num::<f64>() - trace[settle].2.friction_energy_j.to_num::<f64>();
     let plant_energy = plant.energy - plant.energy_log[settle];
@@ -348,14 +348,14 @@ fn negative_load_mirrors() {
 #[test]
 fn pack_losing_grip_while_holding_raises_brake_slip() {
     let mut plant = Plant::new(20.3, 13.78);
-    let mut monitor = Monitor::new(Config::default()).unwrap();
+    let mut monitor = Monitor::new(Config::physical_reading()).unwrap();
     let mut trace = run(&mut plant, &mut monitor, 13.78, 0.2, 0.5);
     assert!(!trace.last().unwrap().2.flags.any());
     // The spring breaks and μ drops: capacity 0.3 × nominal < load, and μ_s·c·k·0.3 < 1: the
     // pack no longer self-locks and the output creeps away under the load.
     plant.pack_factor = 0.3;
     let start = plant.theta;
-    let limit = Config::default().thresholds.creep_limit_rad;
+    let limit = Config::physical_reading().thresholds.creep_limit_rad;
     let mut beyond = None;
     for k in 0..3000 {
         plant.tick(None);
@@ -389,7 +389,7 @@ fn pack_losing_grip_while_holding_raises_brake_slip() {
 fn dragging_pack_while_driving_raises_brake_drag() {
     // Drive, stop and hold (load learned), then drive again with a pack dragging 12 N·m more than nominal.
     let mut plant = Plant::new(-10.0, 5.0);
-    let mut monitor = Monitor::new(Config::default()).unwrap();
+    let mut monitor = Monitor::new(Config::physical_reading()).unwrap();
     let mut trace = run(&mut plant, &mut monitor, 5.0, 0.3, 0.6);
     assert!(
         !trace.last().unwrap().2.flags.any(),
@@ -433,7 +433,7 @@ fn drive_with_a_change_at(
     change: impl Fn(&mut Plant, f64),
 ) -> (Vec<(f64, f64, Estimate)>, f64) {
     let mut plant = Plant::new(load, speed);
-    let mut monitor = Monitor::new(Config::default()).unwrap();
+    let mut monitor = Monitor::new(Config::physical_reading()).unwrap();
     let mut trace = Vec::new();
     for k in 0..7000 {
         let t = f64::from(k) * H;
@@ -536,7 +536,7 @@ fn load_changing_at_a_door_like_rate_mid_drive_raises_nothing() {
 #[test]
 fn nominal_restart_raises_nothing() {
     let mut plant = Plant::new(-10.0, 5.0);
-    let mut monitor = Monitor::new(Config::default()).unwrap();
+    let mut monitor = Monitor::new(Config::physical_reading()).unwrap();
     let mut trace = run(&mut plant, &mut monitor, 5.0, 0.3, 0.6);
     let restart = trace.last().unwrap().0;
     for k in 0..6000 {
@@ -563,7 +563,7 @@ fn power_on_with_the_drive_starting_from_rest_raises_nothing() {
     for load in [-25.0, -10.0, 10.0, 25.0] {
         for speed in [5.0, 20.0] {
             let mut plant = Plant::new(load, 0.0);
-            let mut monitor = Monitor::new(Config::default()).unwrap();
+            let mut monitor = Monitor::new(Config::physical_reading()).unwrap();
             let trace = run(&mut plant, &mut monitor, speed, 0.6, 1.2);
             let flagged = trace.iter().find(|x| x.2.flags.any());
             assert!(
@@ -714,7 +714,7 @@ mod envelope {
             .input_torque_nm(plant.sensors.amps_per_count());
         let slope = 2.0 * ak / (ak - 1.0) - 1.0;
         let edge = slope * f64::from(plant.adc_noise + 1) * per_count;
-        let t = Config::default().thresholds;
+        let t = Config::physical_reading().thresholds;
         (along > t.min_load_nm - edge && along <= t.max_load_nm + edge)
             .then_some(speed.signum() * along)
     }
@@ -737,7 +737,7 @@ mod envelope {
             let mut plant = Plant::new(load, speed);
             prop_assume!(ambiguous_reading(&plant, load, speed).is_none());
             plant.out_offset = offset;
-            let mut monitor = Monitor::new(Config::default()).unwrap();
+            let mut monitor = Monitor::new(Config::physical_reading()).unwrap();
             let trace = run(&mut plant, &mut monitor, speed, 0.3, 1.0);
             for (((t, w, e), q), c) in trace.iter().zip(quiet(&trace)).zip(cache_loads(&trace)) {
                 check_shadow(e, q, &c)?;
@@ -776,7 +776,7 @@ mod envelope {
             prop_assume!(along.is_some());
             let want = along.unwrap_or(load);
             plant.out_offset = offset;
-            let mut monitor = Monitor::new(Config::default()).unwrap();
+            let mut monitor = Monitor::new(Config::physical_reading()).unwrap();
             let trace = run(&mut plant, &mut monitor, speed, 0.3, 1.0);
             for (((_, _, e), q), c) in trace.iter().zip(quiet(&trace)).zip(cache_loads(&trace)) {
                 check_shadow(e, q, &c)?;
@@ -804,7 +804,7 @@ mod envelope {
         ) {
             let mut plant = Plant::new(load, speed);
             plant.out_offset = offset;
-            let mut monitor = Monitor::new(Config::default()).unwrap();
+            let mut monitor = Monitor::new(Config::physical_reading()).unwrap();
             let trace = run(&mut plant, &mut monitor, 0.0, 0.0, 1.5);
             // The observer needs its settling time after power-on and after the plant stops
             // abruptly (up to 440 rad/s² to rest in one tick, unknown load): 0.1 s and 50 ms are

@@ -13,7 +13,10 @@
 //! the next drive cut for holding faults, the running drive for drag), against issue 4's
 //! 50 ms.
 
-use host_tests::accuracy::{detection_latency_s, manifest_time, monitor_on_scene, Accuracy};
+use host_tests::accuracy::{
+    compare, detection_latency_s, manifest_time, monitor_on_scene, run_monitor, scene_trace,
+    Accuracy,
+};
 use noback::monitor::Config;
 use noback_twin::fault::{Fault, FaultKind};
 use noback_twin::reading::Reading;
@@ -23,9 +26,15 @@ use noback_twin::trace::{Trace, TraceRow};
 const TARGET_S: f64 = 0.050;
 
 fn run(kind: SceneKind, fault: Option<Fault>) -> (Trace, Accuracy) {
+    run_with(kind, fault, Config::default())
+}
+
+fn run_with(kind: SceneKind, fault: Option<Fault>, config: Config) -> (Trace, Accuracy) {
     let mut scene = Scene::builtin(kind, Reading::Physical);
     scene.faults.extend(fault);
-    monitor_on_scene(&scene).expect("twin and monitor")
+    let trace = scene_trace(&scene).expect("twin");
+    let acc = compare(&trace, &run_monitor(&trace, config).expect("monitor"));
+    (trace, acc)
 }
 
 /// Runs `scene` with `fault` and returns the fault's detection latency (printed with `label`
@@ -58,13 +67,14 @@ fn runaway_time(trace: &Trace) -> f64 {
         .map_or(f64::INFINITY, |r| r.t_s)
 }
 
-fn check_pack_that_cannot_hold(kind: SceneKind) {
+/// A pack that cannot hold: `brake_weak` within `within` seconds of the drive's cut.
+fn check_pack_that_cannot_hold(kind: SceneKind, config: Config, within: f64) {
     let fault = Fault {
         kind: FaultKind::FrictionLoss,
         at_s: 0.1,
         severity: 0.9,
     };
-    let (trace, acc) = run(kind, Some(fault));
+    let (trace, acc) = run_with(kind, Some(fault), config);
     let cut = trace
         .rows
         .iter()
@@ -85,13 +95,13 @@ fn check_pack_that_cannot_hold(kind: SceneKind) {
             .is_some_and(|r| r.output_speed_rad_s.abs() > 20.0),
         "the pack still holds: not a failing brake"
     );
-    // … and the braking envelope calls it within 50 ms of the cut.
+    // … and the braking envelope calls it within `within` of the cut.
     let weak = weak.expect("brake_weak");
     assert!(
-        weak > cut && weak - cut <= TARGET_S,
+        weak > cut && weak - cut <= within,
         "brake_weak {weak} vs cut {cut}"
     );
-    assert!(latency.is_some_and(|l| l <= TARGET_S), "{latency:?}");
+    assert!(latency.is_some_and(|l| l <= within), "{latency:?}");
     // Nothing else before the output leaves the plausible speed range.
     let runaway = runaway_time(&trace);
     for f in &acc.flags {
@@ -106,12 +116,21 @@ fn check_pack_that_cannot_hold(kind: SceneKind) {
 
 #[test]
 fn reverse_load_with_a_pack_that_cannot_hold_raises_brake_weak_within_50_ms_of_the_cut() {
-    check_pack_that_cannot_hold(SceneKind::ReverseLoad);
+    check_pack_that_cannot_hold(SceneKind::ReverseLoad, Config::physical_reading(), TARGET_S);
+}
+
+/// Uncommissioned, the envelope does not count on the pack against the opposing load (the
+/// paper reading's ramps clamp only once the output turns back): the same failure is called
+/// once the load has turned the output back: 0.177 s after the cut (`brake_slip` at 0.128 s),
+/// not the commissioned 50 ms.
+#[test]
+fn reverse_load_with_a_pack_that_cannot_hold_raises_brake_weak_uncommissioned() {
+    check_pack_that_cannot_hold(SceneKind::ReverseLoad, Config::default(), 0.2);
 }
 
 #[test]
 fn forward_load_with_a_pack_that_cannot_hold_raises_brake_weak_within_50_ms_of_the_cut() {
-    check_pack_that_cannot_hold(SceneKind::ForwardLoad);
+    check_pack_that_cannot_hold(SceneKind::ForwardLoad, Config::default(), TARGET_S);
 }
 
 #[test]

@@ -11,7 +11,7 @@ use noback_twin::scene::Scene;
 fn trusted_after_fault(text: &str) -> (bool, usize) {
     let scene = Scene::from_toml("trust", text).unwrap();
     let trace = scene_trace(&scene).unwrap();
-    let estimates = run_monitor(&trace, Config::default()).unwrap();
+    let estimates = run_monitor(&trace, Config::physical_reading()).unwrap();
     let first = estimates.iter().position(|e| e.flags.fault());
     let trusted = first.map_or(0, |i| estimates[i..].iter().filter(|e| e.trusted).count());
     (first.is_some(), trusted)
@@ -36,10 +36,14 @@ fn no_estimate_is_trusted_once_a_fault_flag_is_up() {
 }
 
 #[test]
-fn a_healthy_run_ends_trusted() {
+fn a_healthy_run_ends_trusted_only_when_commissioned() {
     let scene = Scene::from_toml("trust", "[scene]\nkind = \"reverse_load\"\n").unwrap();
     let trace = scene_trace(&scene).unwrap();
-    let estimates = run_monitor(&trace, Config::default()).unwrap();
+    let estimates = run_monitor(&trace, Config::physical_reading()).unwrap();
     let last = estimates.last().unwrap();
     assert!(!last.flags.any() && last.trusted);
+    // Uncommissioned: the same run, the same flags, nothing trusted.
+    let uncommissioned = run_monitor(&trace, Config::default()).unwrap();
+    assert!(uncommissioned.iter().all(|e| !e.trusted));
+    assert!(!uncommissioned.last().unwrap().flags.any());
 }

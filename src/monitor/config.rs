@@ -89,6 +89,10 @@ pub struct Thresholds {
     /// exceed what it would cover at its cut speed, undecelerated, by this much (rad) before
     /// `brake_weak` (a working pack decelerates it from the first millisecond).
     pub undecelerated_allowance_rad: f64,
+    /// Braking against an opposing load: the share of the pack's capacity the nominal braking
+    /// model counts on (0 … 1). Uncommissioned 0 (the paper reading's ramps clamp only once the
+    /// output turns back, so the load alone slows it); 1 where both socket faces clamp at once.
+    pub opposed_braking_share: f64,
     /// Lowest capacity margin (capacity over |load|) before `brake_weak`.
     pub min_capacity_margin: f64,
     /// Loads below this (N·m) are too small for a margin or a load direction.
@@ -136,7 +140,8 @@ pub struct Thresholds {
     pub adc_rail_time_s: f64,
     /// Mean drive torque (N·m, magnitude, over a block of 12.8 ms) below which the current
     /// reading is dead while the drive is on, the output turns and the pack has lately held it
-    /// (`sensor_fault`; `monitor/dead_current.rs`). Must lie below the pack's spring drag
+    /// (`sensor_fault`; `monitor/dead_current.rs`); 0 turns the check off (uncommissioned: the
+    /// paper reading's closing needs almost no drive torque). Must lie below the pack's spring drag
     /// while driving (1.98 N·m with Table 2), around which a moving no-back's drive torque
     /// sits at its lowest (the healthy margin: `cargo run --release -p host-tests --example
     /// dead_current_margin`).
@@ -156,7 +161,8 @@ pub struct Thresholds {
 }
 
 impl Thresholds {
-    /// Defaults for Table 2 and the default sensors.
+    /// Uncommissioned defaults for Table 2 and the default sensors: no false alarm on any
+    /// plant of the family (docs/model.md, "The plant family"); commissioning tightens them.
     pub const DEFAULT: Thresholds = Thresholds {
         max_load_nm: 60.0,
         stick_speed_rad_s: 0.3,
@@ -167,8 +173,9 @@ impl Thresholds {
         slip_reversal_rad: 0.001,
         braking_grace_s: 0.4,
         braking_angle_factor: 2.0,
-        braking_angle_allowance_rad: 0.1, // the twin's healthy pack stops within 0.07 rad
+        braking_angle_allowance_rad: 0.3, // the paper reading's pack: ≤ 0.2 rad past the model
         undecelerated_allowance_rad: 0.01,
+        opposed_braking_share: 0.0, // the paper reading: only the load slows the output
         min_capacity_margin: 1.5,
         min_load_nm: 1.0,
         drag_allowance_nm: 8.0,
@@ -186,11 +193,20 @@ impl Thresholds {
         max_lost_motion_rad: 0.2, // the twin's lost motion is 0.03–0.1 rad
         current_off_max_a: 3.0,
         adc_rail_time_s: 0.01, // overrunning chatter stalls the motor at the current limit ≈ 3 ms
-        dead_current_nm: 0.5,  // healthy ≥ 1.42 N·m; a dead reading's noise ≈ 0.13 N·m
+        dead_current_nm: 0.0,  // off: the paper reading closes on almost no drive torque
         dead_current_speed_rad_s: 2.0,
         health_rate_per_s: 25.0,
         impact_time_s: 0.01,
         impact_window_s: 0.0016,
+    };
+
+    /// Set for the twin's physical reading (the plant they were tuned on): what commissioning
+    /// on that reading gives. Tighter than [`Thresholds::DEFAULT`] where the family differs.
+    pub const PHYSICAL_READING: Thresholds = Thresholds {
+        braking_angle_allowance_rad: 0.1, // the twin's healthy pack stops within 0.07 rad
+        opposed_braking_share: 1.0,       // both socket faces clamp from the cut
+        dead_current_nm: 0.5,             // healthy ≥ 1.42 N·m; a dead reading's noise ≈ 0.13 N·m
+        ..Thresholds::DEFAULT
     };
 }
 
@@ -231,6 +247,9 @@ pub struct Config {
     /// [`DEFAULT_BRAKING_MODEL_HZ`], the cheapest rate meeting the accuracy targets
     /// (docs/results/cheapest-per-scene.md, `cargo xtask bench`).
     pub braking_model_hz: f64,
+    /// Whether the model constants were set for this plant. Uncommissioned (false) no estimate
+    /// is trusted: on the plant family its errors reach 30–100 % (docs/monitor.md); flags run.
+    pub commissioned: bool,
 }
 
 /// Default rate of the fault-braking model (Hz): the cheapest-per-scene table's choice for
@@ -256,6 +275,19 @@ impl Config {
             backdrive_efficiency: 1.0 / sensors.reducer_efficiency,
             max_catchup_ticks: 8,
             braking_model_hz: DEFAULT_BRAKING_MODEL_HZ,
+            commissioned: false,
+        }
+    }
+}
+
+impl Config {
+    /// The defaults with [`Thresholds::PHYSICAL_READING`]: the monitor set for the twin's
+    /// physical reading, as a commissioning on that reading sets it.
+    pub fn physical_reading() -> Config {
+        Config {
+            thresholds: Thresholds::PHYSICAL_READING,
+            commissioned: true,
+            ..Config::default()
         }
     }
 }

@@ -32,6 +32,9 @@ pub(crate) struct LoadSettings {
     min_margin: Scale<26>,
     /// Health change per slow-lane update (Q16 bits).
     health_step: i32,
+    /// Health is learned against an opposing load too: only where the envelope counts on the
+    /// whole capacity there (`opposed_braking_share` = 1, both socket faces clamp).
+    pub learn_opposed: bool,
 }
 
 impl LoadSettings {
@@ -54,6 +57,7 @@ impl LoadSettings {
                 "thresholds.min_capacity_margin",
             )?,
             health_step: ((health_step * Q16_ONE + 0.5) as i32).max(1),
+            learn_opposed: t.opposed_braking_share >= 1.0,
         })
     }
 }

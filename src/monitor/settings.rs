@@ -25,6 +25,8 @@ pub(crate) struct Settings {
     pub load: LoadSettings,
     pub estimate: EstimateSettings,
     pub checks: CheckSettings,
+    /// No estimate is trusted unless the monitor was set for its plant.
+    pub commissioned: bool,
 }
 
 impl Settings {
@@ -43,6 +45,7 @@ impl Settings {
             load: LoadSettings::new(c)?,
             estimate: EstimateSettings::new(c)?,
             checks: CheckSettings::new(c, &pack, &ratios)?,
+            commissioned: c.commissioned,
         })
     }
 }

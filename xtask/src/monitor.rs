@@ -1,4 +1,4 @@
-//! `cargo xtask monitor SCENE|SCENE.toml|TRACE.csv [--json] [--out DIR]` — the monitor against
+//! `cargo xtask monitor SCENE|SCENE.toml|TRACE.csv [--config FILE] [--json] [--out DIR]` — the monitor against
 //! the twin on one scene (or on a recorded trace): accuracy figures, flags, detection latency per injected fault, false alarms, and a
 //! plot with the twin's raw and compared signals beside the monitor's estimate.
 //! The comparison itself lives in `host_tests::accuracy` (this file only runs and reports).
@@ -27,6 +27,10 @@ pub struct MonitorArgs {
     /// Print the report as one JSON object.
     #[arg(long)]
     pub json: bool,
+    /// The monitor's configuration file (docs/monitor-design.md, "Configuration file");
+    /// default: uncommissioned.
+    #[arg(long, value_name = "FILE")]
+    pub config: Option<PathBuf>,
     /// Where the plot goes.
     #[arg(long, value_name = "DIR", default_value_os_t = workspace_root().join("target").join("monitor"))]
     pub out: PathBuf,
@@ -56,7 +60,17 @@ pub fn main(a: &MonitorArgs) -> Result<i32, String> {
             Err(e) => return Ok(bad_input("monitor", &e)),
         }
     };
-    let estimates = run_monitor(&trace, Config::default())?;
+    let config = match &a.config {
+        None => Config::default(),
+        Some(path) => match std::fs::read_to_string(path)
+            .map_err(|e| e.to_string())
+            .and_then(|t| host_tests::config_file::parse(&t))
+        {
+            Ok(c) => c,
+            Err(e) => return Ok(bad_input("monitor", &format!("{}: {e}", path.display()))),
+        },
+    };
+    let estimates = run_monitor(&trace, config)?;
     let acc = compare(&trace, &estimates);
 
     let detections: Vec<_> = faults
@@ -91,6 +105,7 @@ pub fn main(a: &MonitorArgs) -> Result<i32, String> {
         "flags": flags,
         "detection_latency_s": detections,
         "false_alarms": false_alarms(&faults, &acc),
+        "config": a.config.as_ref().map_or("uncommissioned".into(), |p| p.display().to_string()),
     });
 
     std::fs::create_dir_all(&out).map_err(|e| format!("{}: {e}", out.display()))?;
@@ -176,6 +191,7 @@ mod tests {
             main(&MonitorArgs {
                 target: target.into(),
                 json: false,
+                config: None,
                 out: std::env::temp_dir(),
             })
         };
@@ -190,5 +206,14 @@ mod tests {
         assert_eq!(run(&truncated), Ok(EXIT_INPUT));
         let other = write("other.trace.csv", &format!("# noback-trace v9\n{cols}\n"));
         assert_eq!(run(&other), Ok(EXIT_INPUT));
+        // A configuration file with an unknown key.
+        let config = write("bad.config.toml", "[monitor.thresholds]\nbogus = 1\n");
+        let with = MonitorArgs {
+            target: "reverse_load".into(),
+            json: false,
+            config: Some(config.into()),
+            out: std::env::temp_dir(),
+        };
+        assert_eq!(main(&with), Ok(EXIT_INPUT));
     }
 }

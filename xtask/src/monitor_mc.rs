@@ -256,7 +256,7 @@ fn campaign_of(setup: &Setup, family: Family, seed: u64, runs: u64, fault_runs: 
 }
 
 fn run_main(a: &RunArgs) -> Result<(), Fail> {
-    let mut setup = Setup::default();
+    let mut setup = Setup::for_family(a.family);
     if let Some(s) = a.power_on_settle {
         setup.config.thresholds.power_on_settle_s = s;
     }
@@ -280,7 +280,7 @@ fn run_main(a: &RunArgs) -> Result<(), Fail> {
         return Ok(());
     }
     // The page describes the shipped monitor: an ablation does not overwrite it.
-    let shipped = Setup::default();
+    let shipped = Setup::for_family(a.family);
     let ablation = setup.config != shipped.config
         || setup.pre_roll_s != shipped.pre_roll_s
         || a.legacy_draws
@@ -302,7 +302,11 @@ fn merge_main(m: &MergeArgs) -> Result<(), Fail> {
         parts.push((name, part));
     }
     // The setup the parts were run with, which must be this build's monitor.
-    let shipped = Setup::default();
+    let family = parts
+        .first()
+        .and_then(|(_, p)| Family::parse(&p.campaign.plant_family))
+        .unwrap_or(Family::PhysicalDefault);
+    let shipped = Setup::for_family(family);
     let mut setup = shipped;
     if let Some((name, p)) = parts.first() {
         setup.pre_roll_s = p.campaign.pre_roll_s;

@@ -37,7 +37,7 @@
 
 use crate::fx::{counter_delta, Q16};
 use crate::monitor::config::{Config, ConfigError};
-use crate::monitor::convert::{counts, positive, q16, require};
+use crate::monitor::convert::{counts, finite, positive, q16, require};
 use crate::monitor::pack::PackRatios;
 use crate::monitor::schedule::WINDOW;
 
@@ -60,8 +60,10 @@ impl DeadCurrentSettings {
     pub fn new(c: &Config, r: &PackRatios) -> Result<DeadCurrentSettings, ConfigError> {
         let t = &c.thresholds;
         let block = f64::from(BLOCK_WINDOWS);
-        let dead = positive(t.dead_current_nm, "thresholds.dead_current_nm")?;
-        // Below the spring drag a moving no-back's drive always carries.
+        // 0 turns the check off (a sum of magnitudes is never below 0). Below the spring drag a
+        // moving no-back's drive always carries.
+        let dead = finite(t.dead_current_nm, "thresholds.dead_current_nm")?;
+        require(dead >= 0.0, "thresholds.dead_current_nm")?;
         require(dead < r.drive_drag_nm, "thresholds.dead_current_nm")?;
         let speed = positive(
             t.dead_current_speed_rad_s,
@@ -188,7 +190,7 @@ mod tests {
     use crate::monitor::Config;
 
     fn params() -> DeadCurrentSettings {
-        match crate::monitor::settings::Settings::new(&Config::default())
+        match crate::monitor::settings::Settings::new(&Config::physical_reading())
             .map(|s| s.checks.dead_current)
         {
             Ok(p) => p,

@@ -11,7 +11,8 @@
 
 use crate::fx::Q16;
 use crate::monitor::config::{Config, ConfigError};
-use crate::monitor::convert::{counts, positive, scale, ticks, Q16_ONE};
+use crate::monitor::convert::{counts, finite, positive, q16, require, scale, ticks, Q16_ONE};
+use crate::monitor::mul_q16;
 use crate::monitor::pack::Dir;
 use crate::monitor::scale::Scale;
 use crate::monitor::schedule::Slot;
@@ -42,6 +43,8 @@ pub(crate) struct EnvelopeSettings {
     angle_allowance: i32,
     /// Q16 output counts.
     undecelerated_allowance: i32,
+    /// Share of the capacity counted on against an opposing load (Q16, 0 … 1).
+    opposed_share: Q16,
 }
 
 impl EnvelopeSettings {
@@ -73,6 +76,14 @@ impl EnvelopeSettings {
                 t.braking_angle_allowance_rad,
                 "thresholds.braking_angle_allowance_rad",
             )?,
+            opposed_share: {
+                let share = finite(t.opposed_braking_share, "thresholds.opposed_braking_share")?;
+                require(
+                    (0.0..=1.0).contains(&share),
+                    "thresholds.opposed_braking_share",
+                )?;
+                q16(share, "thresholds.opposed_braking_share")?
+            },
             undecelerated_allowance: q16_counts(
                 t.undecelerated_allowance_rad,
                 "thresholds.undecelerated_allowance_rad",
@@ -168,7 +179,7 @@ impl Envelope {
         let decel = if b.dir == b.load_dir {
             b.capacity.saturating_sub(b.load_abs)
         } else {
-            b.capacity.saturating_add(b.load_abs)
+            mul_q16(k.opposed_share, b.capacity).saturating_add(b.load_abs)
         }
         .max(Q16::ZERO);
         // The usual step's constants are precomputed; a longer one (a late tick, or the first

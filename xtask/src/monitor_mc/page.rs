@@ -12,23 +12,24 @@ use std::fmt::Write as _;
 /// The committed record of the certification-scale nominal campaign (a merged report).
 pub const CAMPAIGN_RECORD: &str = "docs/results/mc-nominal-campaign.json";
 
-/// The campaign of [`CAMPAIGN_RECORD`] as planned: nominal runs, shards, seed.
-pub const CAMPAIGN_PLAN: (u64, u64, u64) = (100_000, 20, 101);
+/// The campaign of [`CAMPAIGN_RECORD`] as planned: nominal runs, shards, seed, plant family.
+pub const CAMPAIGN_PLAN: (u64, u64, u64, &str) = (100_000, 4, 2718, "plant");
 
 /// The `--shard` values of the plan's campaign that cover its first `runs` runs.
 pub fn campaign_shards(runs: u64) -> Vec<String> {
-    let (planned, shards, _) = CAMPAIGN_PLAN;
+    let (planned, shards, _, _) = CAMPAIGN_PLAN;
     (0..runs * shards / planned)
         .map(|k| format!("{k}/{shards}"))
         .collect()
 }
 
-/// The commands that made [`CAMPAIGN_RECORD`] of `runs` runs: the shards two at a time (one per
-/// core), then the merge (`--prefix` when they cover only the first runs of the plan).
+/// The commands that made [`CAMPAIGN_RECORD`] of `runs` runs: the shards one after the other
+/// (each on the machine's cores), then the merge (`--prefix` when they cover only the first
+/// runs of the plan).
 pub fn campaign_command(runs: u64) -> String {
-    let (planned, _, seed) = CAMPAIGN_PLAN;
+    let (planned, _, seed, family) = CAMPAIGN_PLAN;
     format!(
-        "printf '%s\\n' {} | xargs -P 2 -I S sh -c 'nice -n 5 cargo xtask monitor-mc --runs {planned} --fault-runs 0 --seed {seed} --threads 1 --shard S --out part-$(echo S | tr / -).json'\ncargo xtask monitor-mc merge part-*.json{} --no-doc --out {CAMPAIGN_RECORD}",
+        "for S in {}; do cargo xtask monitor-mc --family {family} --runs {planned} --fault-runs 0 --seed {seed} --shard $S --out part-$(echo $S | tr / -).json; done\ncargo xtask monitor-mc merge part-*.json{} --no-doc --out {CAMPAIGN_RECORD}",
         campaign_shards(runs).join(" "),
         if runs < planned { " --prefix" } else { "" }
     )
@@ -73,14 +74,38 @@ pub fn false_alarm_line(r: &Value) -> String {
     )
 }
 
+/// Per plant form (a record of the plant family), each form's false alarms with their bound.
+fn form_lines(r: &Value) -> String {
+    let Some(forms) = r["by_form"].as_object() else {
+        return String::new();
+    };
+    let mut s = String::from("\n| plant form | nominal runs | with a false alarm | rate [95 % interval] | not driven (apart) |\n|---|---|---|---|---|\n");
+    for (form, v) in forms {
+        let fa = &v["false_alarm"];
+        let _ = writeln!(
+            s,
+            "| {form} | {} | {} | {} [{}, {}] | {} |",
+            fa["of"][1],
+            fa["of"][0],
+            sci(&fa["rate"]),
+            sci(&fa["ci95"][0]),
+            sci(&fa["ci95"][1]),
+            v["not_driven"]
+        );
+    }
+    s
+}
+
 /// The report as Markdown tables.
 pub fn table(r: &Value) -> String {
     let mut s = String::new();
     let _ = writeln!(
         s,
-        "{} Twin errors: {}.\n",
+        "{} Twin errors: {}. Nominal draws whose plant does not move its output while driven \
+         (counted apart): {}.\n",
         false_alarm_line(r),
-        r["twin_errors"].as_array().map_or(0, Vec::len)
+        r["twin_errors"].as_array().map_or(0, Vec::len),
+        r["not_driven_runs"].as_u64().unwrap_or(0)
     );
     let _ = writeln!(s, "| fault kind | runs | manifested | detected ≤ 50 ms | rate [95 % interval] | median latency (ms) | max latency (ms) | false alarms before onset | onset after settling: detected / manifested | rate there [95 % interval] |");
     let _ = writeln!(s, "|---|---|---|---|---|---|---|---|---|---|");
@@ -201,11 +226,11 @@ fn campaign_sizes(r: &Value) -> String {
 }
 
 /// The certification-scale campaign's paragraph, from its committed record.
-fn campaign_section(record: Option<&Value>, current: &Value) -> String {
+fn campaign_section(record: Option<&Value>) -> String {
     let Some(c) = record else {
         return format!("No record in `{CAMPAIGN_RECORD}` yet.\n");
     };
-    let (planned, shards, _) = CAMPAIGN_PLAN;
+    let (planned, shards, _, _) = CAMPAIGN_PLAN;
     let runs = c["runs"].as_u64().unwrap_or(0);
     let done = if runs < planned {
         format!(
@@ -219,10 +244,15 @@ fn campaign_section(record: Option<&Value>, current: &Value) -> String {
     } else {
         format!("all {shards} shards run and merged")
     };
-    let stale = if c["config_digest"] == current["config_digest"] {
+    // The record is current when it was made with the configuration its family runs today.
+    let family_digest = c["plant_family"]
+        .as_str()
+        .and_then(host_tests::family::Family::parse)
+        .map(|f| super::part::config_digest(&f.config()));
+    let stale = if family_digest.as_deref() == c["config_digest"].as_str() {
         ""
     } else {
-        " (not this page's monitor configuration: the bound is for the configuration recorded)"
+        " (not this build's configuration for that family: the bound is for the configuration recorded)"
     };
     // A record made on an earlier monitor says so (`measured_on`): its bound is that monitor's.
     let stale = match c["measured_on"].as_str() {
@@ -235,12 +265,13 @@ fn campaign_section(record: Option<&Value>, current: &Value) -> String {
     format!(
         "Seed {} ({seed_note}), plant family `{}`, monitor \
          configuration digest {}{stale}. Planned: {planned} nominal runs in {shards} shards on this \
-         machine; {done}:\n\n```sh\n{}\n```\n\n{}\n",
+         machine; {done}:\n\n```sh\n{}\n```\n\n{}\n{}",
         c["seed"],
         c["plant_family"].as_str().unwrap_or(""),
         c["config_digest"].as_str().unwrap_or(""),
         campaign_command(runs),
         false_alarm_line(c),
+        form_lines(c),
     )
 }
 
@@ -253,7 +284,9 @@ pub fn doc(r: &Value, record: Option<&Value>) -> String {
          time of larger campaigns are on the benchmark page `results/mc-throughput.md`.\n\n\
          ## How it is measured\n\n\
          - Every run: a twin scene (physical reading) → its 10 kHz sensor trace (quantised, with \
-         current noise) → the shipped monitor, configured with the nominal Table 2, stepped on \
+         current noise) → the shipped monitor, configured with the nominal Table 2 and the \
+         settings set for the physical reading (`Config::physical_reading()`; the plant-family \
+         campaign below runs it uncommissioned, `Config::default()`), stepped on \
          the host (bit-identical to the Cortex-M targets: `cargo xtask run` checks it). The \
          monitor is powered on {pre_roll:.0} ms into the twin's run (`host_tests::mc::PRE_ROLL_S`): \
          the twin's scenes start mid-drive from a state that is not its drive's equilibrium, and \
@@ -264,7 +297,9 @@ pub fn doc(r: &Value, record: Option<&Value>) -> String {
          pack's engagement chatter); load 5–30 N·m; speed 5–20 rad/s (the input's, in \
          continuous_closing); drive cut at 0.1–0.3 s; every Table 2 parameter scaled by its \
          own factor in [0.9, 1.1]; current noise 0–0.1 A; the load in either direction (a mirrored run negates \
-         every sensor reading). Any flag in a nominal run is a false alarm.\n\
+         every sensor reading). Any flag in a nominal run is a false alarm, except in a draw \
+         whose plant does not move its output while driven (counted apart: `model.md`, \
+         \"The plant family\").\n\
          - Fault draws: the same plus one fault, onset uniform over the scene, severity \
          0.5–1 (each kind's meaning is in `model.md`).\n\
          - Each run's random draws come from its own stream, the SplitMix hash of (seed, nominal \
@@ -325,7 +360,7 @@ pub fn doc(r: &Value, record: Option<&Value>) -> String {
         compare = COMPARE_WINDOW_S * 1e3,
         table = table(r),
         met = if r["targets_met"] == true { "yes" } else { "no" },
-        campaign = campaign_section(record, r),
+        campaign = campaign_section(record),
         sizes = campaign_sizes(r),
         rattle = HELD_RATTLE_RAD,
         pre_roll = PRE_ROLL_S * 1e3,

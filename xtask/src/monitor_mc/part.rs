@@ -56,8 +56,11 @@ pub struct Part {
     pub nominal: [u64; 2],
     /// The run indices covered of every fault kind, `[start, end)`.
     pub faults: [u64; 2],
-    /// Nominal runs with any flag.
+    /// Nominal runs with any flag (not-driven runs apart).
     pub false_alarm_runs: Vec<u64>,
+    /// Nominal runs whose plant did not move its output while driven (`mc::not_driven`).
+    #[serde(default)]
+    pub not_driven_runs: Vec<u64>,
     pub nominal_errors: Vec<RunError>,
     /// Every fault run, kind by kind in `FAULT_KINDS` order, each by index.
     pub fault_runs: Vec<FaultRun>,
@@ -109,7 +112,13 @@ impl Part {
             false_alarm_runs: nominal
                 .clone()
                 .zip(nom)
-                .filter(|(_, o)| o.error.is_none() && o.false_flags > 0)
+                .filter(|(_, o)| o.error.is_none() && !o.not_driven && o.false_flags > 0)
+                .map(|(i, _)| i)
+                .collect(),
+            not_driven_runs: nominal
+                .clone()
+                .zip(nom)
+                .filter(|(_, o)| o.error.is_none() && o.not_driven)
                 .map(|(i, _)| i)
                 .collect(),
             nominal_errors: nominal
@@ -157,6 +166,7 @@ fn outcome_of(r: &FaultRun) -> Result<Outcome, String> {
         context,
         false_flags: r.false_flags,
         error: r.error.clone(),
+        not_driven: false,
     })
 }
 
@@ -248,6 +258,7 @@ fn check(name: &str, p: &Part, first: &(String, Campaign)) -> Result<(), String>
     }
     let in_nominal = |i: &u64| (p.nominal[0]..p.nominal[1]).contains(i);
     if !p.false_alarm_runs.iter().all(in_nominal)
+        || !p.not_driven_runs.iter().all(in_nominal)
         || !p.nominal_errors.iter().all(|e| in_nominal(&e.index))
     {
         return Err(format!("{name}: names a nominal run outside its range"));
@@ -290,6 +301,7 @@ pub fn merge(parts: &[(String, Part)], prefix: bool) -> Result<(Campaign, Vec<Ou
             context: None,
             false_flags: 0,
             error: None,
+            not_driven: false,
         };
         c.runs as usize
     ];
@@ -297,6 +309,9 @@ pub fn merge(parts: &[(String, Part)], prefix: bool) -> Result<(Campaign, Vec<Ou
     for (name, p) in parts {
         for &i in &p.false_alarm_runs {
             nominal[i as usize].false_flags = 1;
+        }
+        for &i in &p.not_driven_runs {
+            nominal[i as usize].not_driven = true;
         }
         for e in &p.nominal_errors {
             nominal[e.index as usize].error = Some(e.error.clone());

@@ -50,9 +50,10 @@ fn detected(o: &Outcome) -> bool {
 /// in [`FAULT_KINDS`] order, each by run index).
 pub fn build(meta: &Meta, outcomes: &[Outcome]) -> Result<Value, String> {
     let errors: Vec<&str> = outcomes.iter().filter_map(|o| o.error.as_deref()).collect();
+    let not_driven = outcomes.iter().filter(|o| o.not_driven).count();
     let nominal: Vec<&Outcome> = outcomes
         .iter()
-        .filter(|o| o.fault.is_none() && o.error.is_none())
+        .filter(|o| o.fault.is_none() && o.error.is_none() && !o.not_driven)
         .collect();
     let false_alarm_runs = nominal.iter().filter(|o| o.false_flags > 0).count();
     let false_alarm = rate(false_alarm_runs, nominal.len());
@@ -128,6 +129,7 @@ pub fn build(meta: &Meta, outcomes: &[Outcome]) -> Result<Value, String> {
         "false_alarm_per_flight_hour_upper95": per_hour,
         "fault_kinds": rows,
         "twin_errors": errors,
+        "not_driven_runs": not_driven,
         "paper_scenes": paper_scenes()?,
         "targets_met": all_ok,
     }))
@@ -183,7 +185,7 @@ pub fn by_form(outcomes: &[Outcome], forms: &[&str]) -> Value {
             .collect();
         let nominal: Vec<&&Outcome> = mine
             .iter()
-            .filter(|o| o.fault.is_none() && o.error.is_none())
+            .filter(|o| o.fault.is_none() && o.error.is_none() && !o.not_driven)
             .collect();
         let false_alarms = nominal.iter().filter(|o| o.false_flags > 0).count();
         let mut detection = serde_json::Map::new();
@@ -200,6 +202,7 @@ pub fn by_form(outcomes: &[Outcome], forms: &[&str]) -> Value {
             json!({
                 "false_alarm": rate(false_alarms, nominal.len()),
                 "errors": mine.iter().filter(|o| o.error.is_some()).count(),
+                "not_driven": mine.iter().filter(|o| o.not_driven).count(),
                 "detection": detection,
             }),
         );
@@ -218,9 +221,10 @@ pub fn form_table(forms: &serde_json::Map<String, Value>) -> String {
     let mut text = String::from("per plant form:\n");
     for (form, v) in forms {
         text.push_str(&format!(
-            "  {form}: false alarms {}, twin errors {}\n",
+            "  {form}: false alarms {}, twin errors {}, not driven {}\n",
             of(&v["false_alarm"]),
-            v["errors"]
+            v["errors"],
+            v["not_driven"]
         ));
         if let Some(d) = v["detection"].as_object() {
             for (kind, r) in d {

@@ -48,7 +48,7 @@ fn shards_merge_to_the_unsharded_campaign_byte_for_byte() {
 
 #[test]
 fn a_plant_family_campaign_reports_each_form_and_merges_exactly() {
-    let setup = Setup::default();
+    let setup = Setup::for_family(Family::Plant);
     let c = campaign_of(&setup, Family::Plant, 11, 12, 0);
     let whole = through_text(&run_part(&setup, c.clone(), 0, 1, 2));
     let (json, _) = report(&[("whole".into(), whole)]);
@@ -57,7 +57,7 @@ fn a_plant_family_campaign_reports_each_form_and_merges_exactly() {
         .expect("a plant campaign reports per form");
     let nominal: u64 = forms
         .values()
-        .map(|f| f["false_alarm"]["of"][1].as_u64().unwrap())
+        .map(|f| f["false_alarm"]["of"][1].as_u64().unwrap() + f["not_driven"].as_u64().unwrap())
         .sum();
     assert_eq!(nominal, 12, "every nominal run falls in one form");
     assert!(forms
@@ -98,6 +98,7 @@ fn merge_refuses_parts_that_do_not_belong_together() {
                 context: None,
                 false_flags: 0,
                 error: None,
+                not_driven: false,
             })
             .collect();
         Part::new(c.clone(), [0, 1], nominal, faults, &outcomes)
