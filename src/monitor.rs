@@ -402,8 +402,8 @@ impl State {
         }
         // Against an opposing load the load itself slows the output: the pack's torque there
         // is known only where both socket faces clamp (`learn_opposed`).
-        let learnable = self.load.estimate.known().is_some()
-            && (k.load.learn_opposed || Dir::of(load, k.scene.min_load) == c.dir);
+        let learnable =
+            self.load.estimate.known().is_some() && (k.load.learn_opposed || c.load_along);
         if moving_ok && !x.drive && learnable {
             let measured = load.saturating_sub(o.net);
             self.load.learn_health(&k.load, c.dir.apply(measured));

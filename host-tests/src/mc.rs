@@ -70,6 +70,13 @@ pub struct Outcome {
     pub not_driven: bool,
 }
 
+impl Outcome {
+    /// A nominal run the false-alarm rate counts: the twin ran it and its plant was driven.
+    pub fn counts_as_nominal(&self) -> bool {
+        self.fault.is_none() && self.error.is_none() && !self.not_driven
+    }
+}
+
 /// Input travel (rad, output side) with the output encoder standing still and the drive on
 /// beyond which a draw's plant is not driving its door: a jammed or decoupled actuator, which
 /// a monitor should flag. Healthy draws of both readings stay below 0.13 rad (seed 1616).

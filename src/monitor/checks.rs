@@ -219,6 +219,7 @@ impl Checks {
         // whose spring broke could be driven by almost nothing).
         if drive
             && i.slot == Slot::DeadCurrent
+            && k.dead_current.on()
             && self
                 .dead_current
                 .window(o.drive_torque, x.out, &k.dead_current)

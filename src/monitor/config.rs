@@ -58,7 +58,9 @@ impl ObserverGains {
 pub const IMPACT_DECAY_RAD_S2: f64 = 10.0;
 
 /// Limits and time constants (SI). Defaults in [`Thresholds::DEFAULT`], with their reasons in
-/// docs/monitor-design.md.
+/// docs/monitor-design.md. With `snapshot`, serde reads and writes them by field name (the
+/// host's configuration file).
+#[cfg_attr(feature = "snapshot", derive(serde::Serialize, serde::Deserialize))]
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Thresholds {
     /// Operating envelope of the load (N·m); an implied load beyond it while driving means the

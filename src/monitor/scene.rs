@@ -117,6 +117,8 @@ pub(crate) struct Classified {
     pub along: Q16,
     /// Overrunning equilibrium `y` (computed only where it is needed, else zero).
     pub overrun_torque: Q16,
+    /// The load estimate lies along the motion, beyond `min_load_nm` (it aids the motion).
+    pub load_along: bool,
     /// A change of driving reading is pending.
     pub pending: bool,
     /// The reading changed this call (bumpless for the observer).
@@ -138,6 +140,7 @@ impl Classified {
         dir: Dir::NONE,
         along: Q16::ZERO,
         overrun_torque: Q16::ZERO,
+        load_along: false,
         pending: false,
         reading_switch: false,
         just_locked: false,
@@ -305,6 +308,7 @@ impl Classify {
             dir,
             along,
             overrun_torque,
+            load_along,
             pending: matches!(self.phase, Phase::Driving(r) if r.pending_ticks != 0),
             reading_switch,
             just_locked,

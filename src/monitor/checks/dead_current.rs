@@ -57,6 +57,12 @@ pub(crate) struct DeadCurrentSettings {
 }
 
 impl DeadCurrentSettings {
+    /// Whether the check runs (`dead_current_nm` > 0): off, it has nothing to find.
+    #[inline]
+    pub fn on(&self) -> bool {
+        self.drive_sum > Q16::ZERO
+    }
+
     pub fn new(c: &Config, r: &PackRatios) -> Result<DeadCurrentSettings, ConfigError> {
         let t = &c.thresholds;
         let block = f64::from(BLOCK_WINDOWS);

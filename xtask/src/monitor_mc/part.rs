@@ -103,24 +103,22 @@ impl Part {
     ) -> Part {
         let (nom, flt) = outcomes.split_at((nominal.end - nominal.start) as usize);
         let fault_indices = FAULT_KINDS.iter().flat_map(|_| faults.clone());
+        let nominal_where = |keep: fn(&Outcome) -> bool| -> Vec<u64> {
+            nominal
+                .clone()
+                .zip(nom)
+                .filter(|(_, o)| keep(o))
+                .map(|(i, _)| i)
+                .collect()
+        };
         Part {
             format: FORMAT.into(),
             campaign,
             shard,
             nominal: [nominal.start, nominal.end],
             faults: [faults.start, faults.end],
-            false_alarm_runs: nominal
-                .clone()
-                .zip(nom)
-                .filter(|(_, o)| o.error.is_none() && !o.not_driven && o.false_flags > 0)
-                .map(|(i, _)| i)
-                .collect(),
-            not_driven_runs: nominal
-                .clone()
-                .zip(nom)
-                .filter(|(_, o)| o.error.is_none() && o.not_driven)
-                .map(|(i, _)| i)
-                .collect(),
+            false_alarm_runs: nominal_where(|o| o.counts_as_nominal() && o.false_flags > 0),
+            not_driven_runs: nominal_where(|o| o.error.is_none() && o.not_driven),
             nominal_errors: nominal
                 .zip(nom)
                 .filter_map(|(index, o)| {

@@ -51,10 +51,7 @@ fn detected(o: &Outcome) -> bool {
 pub fn build(meta: &Meta, outcomes: &[Outcome]) -> Result<Value, String> {
     let errors: Vec<&str> = outcomes.iter().filter_map(|o| o.error.as_deref()).collect();
     let not_driven = outcomes.iter().filter(|o| o.not_driven).count();
-    let nominal: Vec<&Outcome> = outcomes
-        .iter()
-        .filter(|o| o.fault.is_none() && o.error.is_none() && !o.not_driven)
-        .collect();
+    let nominal: Vec<&Outcome> = outcomes.iter().filter(|o| o.counts_as_nominal()).collect();
     let false_alarm_runs = nominal.iter().filter(|o| o.false_flags > 0).count();
     let false_alarm = rate(false_alarm_runs, nominal.len());
     let per_hour = false_alarm["ci95"][1]
@@ -183,10 +180,7 @@ pub fn by_form(outcomes: &[Outcome], forms: &[&str]) -> Value {
             .filter(|(_, f)| **f == form)
             .map(|(o, _)| o)
             .collect();
-        let nominal: Vec<&&Outcome> = mine
-            .iter()
-            .filter(|o| o.fault.is_none() && o.error.is_none() && !o.not_driven)
-            .collect();
+        let nominal: Vec<&&Outcome> = mine.iter().filter(|o| o.counts_as_nominal()).collect();
         let false_alarms = nominal.iter().filter(|o| o.false_flags > 0).count();
         let mut detection = serde_json::Map::new();
         for kind in FAULT_KINDS {
