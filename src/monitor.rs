@@ -56,6 +56,8 @@
 
 mod checks;
 mod config;
+#[cfg(feature = "snapshot")]
+pub mod config_block;
 mod convert;
 mod estimate;
 mod io;
@@ -72,7 +74,7 @@ mod settings;
 mod snapshot;
 
 pub use config::{
-    Config, ConfigError, ObserverGains, Thresholds, DEFAULT_BRAKING_MODEL_HZ,
+    Config, ConfigError, DrivingPack, ObserverGains, Thresholds, DEFAULT_BRAKING_MODEL_HZ,
     DEFAULT_OBSERVER_BANDWIDTH_HZ, DEFAULT_TICK_HZ, POWER_ON_SEED_TICKS,
 };
 pub use io::{BrakeState, Estimate, Flags, Inputs, Scene, SceneModel, ESTIMATE_WORDS};

@@ -7,11 +7,14 @@
 //! [monitor]
 //! base = "uncommissioned"        # or "physical_reading"
 //! sliding_mu = 0.12
+//! driving_pack = "spring_only"   # or "relieved" (the default)
+//! current_offset_a = 0.05        # the current reading at zero current
+//! motor_torque_constant_nm_a = 0.066
 //! [monitor.thresholds]
 //! opposed_braking_share = 1.0
 //! ```
 
-use noback::monitor::{Config, Monitor, Thresholds};
+use noback::monitor::{Config, DrivingPack, Monitor, Thresholds};
 use toml::{Table, Value};
 
 fn number(v: &Value, key: &str) -> Result<f64, String> {
@@ -80,9 +83,22 @@ pub fn parse(text: &str) -> Result<Config, String> {
         ("sliding_mu", &mut c.sliding_mu),
         ("backdrive_efficiency", &mut c.backdrive_efficiency),
         ("braking_model_hz", &mut c.braking_model_hz),
+        ("current_offset_a", &mut c.current_offset_a),
+        (
+            "motor_torque_constant_nm_a",
+            &mut c.sensors.motor_torque_constant_nm_a,
+        ),
     ] {
         if let Some(v) = m.remove(key) {
             *field = number(&v, &format!("monitor.{key}"))?;
+        }
+    }
+    match m.remove("driving_pack") {
+        None => {}
+        Some(Value::String(s)) if s == "relieved" => c.driving_pack = DrivingPack::Relieved,
+        Some(Value::String(s)) if s == "spring_only" => c.driving_pack = DrivingPack::SpringOnly,
+        Some(_) => {
+            return Err("monitor.driving_pack: expected \"relieved\" or \"spring_only\"".into())
         }
     }
     match m.remove("commissioned") {
@@ -93,6 +109,51 @@ pub fn parse(text: &str) -> Result<Config, String> {
     no_more(&m, "monitor.")?;
     Monitor::new(c).map_err(|e| format!("{e:?}"))?;
     Ok(c)
+}
+
+/// The file of `c` over the uncommissioned base: every model constant the file carries and the
+/// thresholds that differ from the base. Refuses a `Config` the file cannot carry whole.
+pub fn write(c: &Config, comment: &str) -> Result<String, String> {
+    let mut out = String::new();
+    for line in comment.lines() {
+        out.push_str(&format!("# {line}\n"));
+    }
+    out.push_str("[monitor]\nbase = \"uncommissioned\"\n");
+    for (key, v) in [
+        ("capacity_mu", c.capacity_mu),
+        ("sliding_mu", c.sliding_mu),
+        ("backdrive_efficiency", c.backdrive_efficiency),
+        ("braking_model_hz", c.braking_model_hz),
+        ("current_offset_a", c.current_offset_a),
+        (
+            "motor_torque_constant_nm_a",
+            c.sensors.motor_torque_constant_nm_a,
+        ),
+    ] {
+        out.push_str(&format!("{key} = {v:?}\n"));
+    }
+    let pack = match c.driving_pack {
+        DrivingPack::Relieved => "relieved",
+        DrivingPack::SpringOnly => "spring_only",
+    };
+    out.push_str(&format!(
+        "driving_pack = \"{pack}\"\ncommissioned = {}\n[monitor.thresholds]\n",
+        c.commissioned
+    ));
+    let base = Value::try_from(Thresholds::DEFAULT).map_err(|e| e.to_string())?;
+    let now = Value::try_from(c.thresholds).map_err(|e| e.to_string())?;
+    if let (Value::Table(base), Value::Table(now)) = (base, now) {
+        for (key, v) in now {
+            if base.get(&key) != Some(&v) {
+                out.push_str(&format!("{key} = {:?}\n", number(&v, &key)?));
+            }
+        }
+    }
+    match parse(&out) {
+        Ok(back) if back == *c => Ok(out),
+        Ok(_) => Err("the configuration sets a field the file does not carry".into()),
+        Err(e) => Err(e),
+    }
 }
 
 #[cfg(test)]
@@ -111,6 +172,19 @@ mod tests {
         )
         .unwrap();
         assert!(c.commissioned && c.thresholds.opposed_braking_share == 1.0);
+    }
+
+    #[test]
+    fn a_written_file_reads_back_the_same_configuration() {
+        let mut c = Config::physical_reading();
+        c.sliding_mu = 0.2345678901;
+        c.driving_pack = DrivingPack::SpringOnly;
+        c.thresholds.creep_limit_rad = 0.125;
+        let text = write(&c, "test").unwrap();
+        assert_eq!(parse(&text), Ok(c), "{text}");
+        let mut other = c;
+        other.tick_hz = 5_000.0;
+        assert!(write(&other, "").is_err());
     }
 
     #[test]

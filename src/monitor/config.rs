@@ -7,6 +7,7 @@ use crate::sensors::{SensorConfig, DEFAULT_SENSORS};
 
 /// Observer gains of the current-estimator form (see [`crate::monitor`]): the angle, speed and
 /// acceleration corrections per unit of angle innovation.
+#[cfg_attr(feature = "snapshot", derive(serde::Serialize, serde::Deserialize))]
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct ObserverGains {
     /// l₁, angle correction (dimensionless).
@@ -218,7 +219,21 @@ impl Default for Thresholds {
     }
 }
 
-/// Everything the monitor is configured with; separate from its state.
+/// How the pack is pressed while the drive turns the output against the load: a plant fact the
+/// paper leaves open (docs/model.md, "The plant family"), set by commissioning.
+#[cfg_attr(feature = "snapshot", derive(serde::Serialize, serde::Deserialize))]
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum DrivingPack {
+    /// The drive's pull on the ramps unloads the spring: `F = F_s/(1 + a·k)` (the physical
+    /// reading; the default).
+    Relieved,
+    /// The ramps stay open: the spring alone presses the pack, `F = F_s` (the paper reading).
+    SpringOnly,
+}
+
+/// Everything the monitor is configured with; separate from its state. With `snapshot`, serde
+/// writes it as the firmware's configuration block (`config_block`).
+#[cfg_attr(feature = "snapshot", derive(serde::Serialize, serde::Deserialize))]
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Config {
     /// The mechanism (Table 2 by default).
@@ -241,6 +256,11 @@ pub struct Config {
     /// Factor from motor torque × ratio to output torque when the load back-drives the motor
     /// (power flowing to the motor); default `1/η`. When motoring, `η` is used.
     pub backdrive_efficiency: f64,
+    /// How the pack is pressed while driving against the load (its force and drag then).
+    pub driving_pack: DrivingPack,
+    /// The phase-current reading at zero current (A), measured at commissioning with the drive
+    /// off; subtracted in whole ADC counts (at most an eighth of full scale).
+    pub current_offset_a: f64,
     /// Most ticks one late step may cover (1..=32); the observer must be stable when advanced
     /// by any of 1..=this many ticks with one correction.
     pub max_catchup_ticks: u8,
@@ -275,6 +295,8 @@ impl Config {
             capacity_mu: mechanism.mu_static,
             sliding_mu: mechanism.mu_dynamic,
             backdrive_efficiency: 1.0 / sensors.reducer_efficiency,
+            driving_pack: DrivingPack::Relieved,
+            current_offset_a: 0.0,
             max_catchup_ticks: 8,
             braking_model_hz: DEFAULT_BRAKING_MODEL_HZ,
             commissioned: false,

@@ -7,7 +7,7 @@
 //! | `Driving` | `F_drive = F_s/(1 + a·k)` | Table 1 at the drive drag `a·F_drive` |
 //! | `Overrunning` | `F_s + k·(T_o − v)`, `T_o = y − v` | `y = g₁·v − g₀` against the motion |
 //! | `Holding` | `F_s + k·|T|` | `T = M̂ − J_s·α` (α from the impacts of the rattle) |
-//! | `FaultBraking` | `F_s + k·|T|` | `T` measured: `M̂ − (J_s·ω̇ − u)` |
+//! | `FaultBraking` | `F_s + k·|T|` (`F_s` for a spring-only pack against the load) | `T` measured: `M̂ − (J_s·ω̇ − u)` |
 //!
 //! Engaged, the torque is bounded by the capacity at that force (it binds only when the force
 //! saturates or the pack does not self-lock).
@@ -128,7 +128,15 @@ pub(crate) fn pack(k: &PackSettings, c: &Classified, i: &PackInputs) -> PackEsti
             } else {
                 i.measured
             };
-            (k.clamped_force(t), t)
+            let open = k.spring_only && c.scene == Scene::FaultBraking && !c.load_along;
+            (
+                if open {
+                    k.spring_force
+                } else {
+                    k.clamped_force(t)
+                },
+                t,
+            )
         }
     };
     // Carried by the drive, the drag is a constant below the capacity: no bound needed.

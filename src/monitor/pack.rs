@@ -6,10 +6,10 @@
 //! | `spring_force` | `F_s`, the spring preload (N) | 169.2 N |
 //! | `ramp_factor` | `k = tanθ/r`: N of pressing force per N·m through the ramps | 50 /m |
 //! | `capacity_per_n` | `μ_s·c`: capacity per N of pressing force (m) | 0.0498 m |
-//! | `drive_force`, `drive_drag` | `F_s/(1 + a·k)` and `a·F` while the drive carries the load | 70 N, 1.98 N·m |
+//! | `drive_force`, `drive_drag` | `F_s/(1 + a·k)` (`F_s` with `DrivingPack::SpringOnly`) and `a·F` while the drive carries the load | 70 N, 1.98 N·m |
 //! | `overrun_gain`, `overrun_offset` | `y = g₁·v − g₀`, the pack torque while overrunning | 6.86, 11.6 N·m |
 
-use super::config::{Config, ConfigError};
+use super::config::{Config, ConfigError, DrivingPack};
 use super::convert::{finite, positive, q16, require, scale, Q16_ENVELOPE};
 use super::scale::Scale;
 use crate::fx::Q16;
@@ -48,6 +48,8 @@ pub(crate) struct PackSettings {
     pub drive_drag: Q16,
     pub overrun_gain: Scale<24>,
     pub overrun_offset: Q16,
+    /// `DrivingPack::SpringOnly`: against an opposing load the ramps stay open, `F = F_s`.
+    pub spring_only: bool,
 }
 
 impl PackSettings {
@@ -100,7 +102,10 @@ impl PackSettings {
         let a = m.pack_torque_per_newton_m(mu_d);
         let a_k = a * ramp;
         require(!(a_k > 0.95 && a_k < 1.05), "sliding_mu")?;
-        let drive_force = spring / (1.0 + a_k);
+        let drive_force = match c.driving_pack {
+            DrivingPack::Relieved => spring / (1.0 + a_k),
+            DrivingPack::SpringOnly => spring,
+        };
         let settings = PackSettings {
             spring_force: q16(spring, "mechanism.spring_preload_m")?,
             ramp_factor: scale(ramp, "mechanism.socket_radius_m")?,
@@ -109,6 +114,7 @@ impl PackSettings {
             drive_drag: q16(a * drive_force, "sliding_mu")?,
             overrun_gain: scale(2.0 * a_k / (a_k - 1.0), "sliding_mu")?,
             overrun_offset: q16(a * spring / (a_k - 1.0), "sliding_mu")?,
+            spring_only: c.driving_pack == DrivingPack::SpringOnly,
         };
         let ratios = PackRatios {
             a_k,

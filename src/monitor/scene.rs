@@ -10,11 +10,12 @@
 //! While driving, the *reading* says who carries the load: the drive (`Driving` scene: pack at
 //! its drag) or the pack (`Overrunning`: the load runs along the motion). The current tells
 //! them apart only when the overrunning reading's load lies outside the envelope; otherwise the
-//! learned load's sign decides, and with no load known yet the overrunning reading is taken.
+//! learned load's sign decides, and with no load known yet the overrunning reading is taken (the
+//! driving one for a `DrivingPack::SpringOnly` pack).
 //! After the first settled decision of a drive, the other reading must be wanted for
 //! `engage_settle_s` (and the step check must not be counting) before it switches.
 
-use super::config::{Config, ConfigError};
+use super::config::{Config, ConfigError, DrivingPack};
 use super::convert::{counts, positive, q16, ticks};
 use super::load::LoadEstimate;
 use super::observe::Observed;
@@ -44,6 +45,9 @@ pub(crate) struct SceneSettings {
     motor_to_out: Scale<30>,
     /// Relative travel (output counts) over a window within the synchronism band.
     sync_band_counts: i32,
+    /// With no load known, take the overrunning reading (a relieved pack: its overrunning
+    /// drive torque lies above the drag); a spring-only pack overruns on almost none.
+    overrun_when_unknown: bool,
 }
 
 impl SceneSettings {
@@ -73,6 +77,7 @@ impl SceneSettings {
                 t.sync_speed_band_rad_s * f64::from(WINDOW.ticks) * (1.0 / tick_hz) / out_rad,
                 "thresholds.sync_speed_band_rad_s",
             )?,
+            overrun_when_unknown: c.driving_pack == DrivingPack::Relieved,
         })
     }
 }
@@ -257,7 +262,7 @@ impl Classify {
                     && along > pack.drive_drag
                     && implied > k.min_load
                     && implied <= k.max_load;
-                let wanted = possible && (!known || load_along);
+                let wanted = possible && (load_along || (!known && k.overrun_when_unknown));
                 Phase::Driving(r.next(wanted, o.settled, n, k.engage_settle_ticks, step_counting))
             }
             (false, p) => {

@@ -11,7 +11,9 @@
 //! | position history | `i16` counts mod 2^16, wrapping | differences over ≤ 63 ticks | 1 count |
 
 use super::config::{Config, ConfigError};
-use super::convert::{counts, filter_gain, positive, require, scale, ticks, Q16_ENVELOPE, Q16_ONE};
+use super::convert::{
+    counts, filter_gain, finite, positive, require, scale, ticks, Q16_ENVELOPE, Q16_ONE,
+};
 use super::scale::Scale;
 use super::schedule::SLOW;
 use super::Inputs;
@@ -28,7 +30,7 @@ const POSITION_HISTORY: usize = 64;
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub(crate) struct SenseSettings {
     adc_max_code: u16,
-    /// Mid-scale code (zero current).
+    /// The code at zero current: mid-scale plus the commissioned offset.
     adc_mid: i32,
     adc_rail_ticks: u32,
     current_off_counts: i32,
@@ -103,6 +105,12 @@ impl SenseSettings {
         }
         let current_off =
             positive(t.current_off_max_a, "thresholds.current_off_max_a")? / s.amps_per_count();
+        // The reading at zero current: mid-scale plus the commissioned offset, in whole counts.
+        let offset = finite(c.current_offset_a, "current_offset_a")? / s.amps_per_count();
+        require(
+            offset.abs() <= f64::from(1_u32 << (s.current_adc_bits - 3)),
+            "current_offset_a",
+        )?;
         let lost = positive(t.max_lost_motion_rad, "thresholds.max_lost_motion_rad")?;
         let impact_m = positive(t.impact_window_s, "thresholds.impact_window_s")? * tick_hz + 0.5;
         require(
@@ -115,7 +123,7 @@ impl SenseSettings {
         let slow_h = h * f64::from(SLOW.ticks);
         Ok(SenseSettings {
             adc_max_code: ((1_u32 << s.current_adc_bits) - 1) as u16,
-            adc_mid: 1 << (s.current_adc_bits - 1),
+            adc_mid: (1 << (s.current_adc_bits - 1)) + rounded(offset),
             adc_rail_ticks: ticks(t.adc_rail_time_s, tick_hz, "thresholds.adc_rail_time_s")?,
             current_off_counts: counts(current_off, "thresholds.current_off_max_a")?,
             out_bits: s.output_encoder_bits,
@@ -394,5 +402,14 @@ pub(crate) fn times(x: i32, n: i32) -> i32 {
         x
     } else {
         x.saturating_mul(n)
+    }
+}
+
+/// `x` rounded half away from zero (|x| checked to fit beforehand).
+fn rounded(x: f64) -> i32 {
+    if x < 0.0 {
+        -((0.5 - x) as i32)
+    } else {
+        (x + 0.5) as i32
     }
 }

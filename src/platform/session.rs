@@ -1,12 +1,13 @@
 //! What every firmware image under QEMU shares, whatever its board: the semihosting
-//! arguments (`trace=FILE`, `bench`, `overrun-at=N`, `reset-every=N`, `trip-log=FILE`), the trace it streams from the host, the boot self-check, the bench loop that
+//! arguments (`trace=FILE`, `bench`, `overrun-at=N`, `reset-every=N`, `trip-log=FILE`,
+//! `config=FILE`), the trace it streams from the host, the boot self-check, the bench loop that
 //! counts instructions, and the log lines the xtask decodes (`cargo xtask run` parses them).
 
 use crate::app::{estimate_checksum, Ticker};
 use crate::board::SampleSource;
 use crate::digest::Fnv1a;
 use crate::event_log::{tick_time, Decimal, Event};
-use crate::monitor::{BrakeState, Config, Monitor, Scene};
+use crate::monitor::{config_block, BrakeState, Config, Monitor, Scene};
 use crate::platform::{self, meter::Meter, stack};
 use crate::replay::{self, Feeder, StreamRing, Streamed, FEED_CHUNK, HEADER_BYTES, RECORD_BYTES};
 use cortex_m::peripheral::SYST;
@@ -16,7 +17,8 @@ use semihosting::io::Read;
 /// Longest trace path the firmware accepts (bytes, without the NUL).
 const PATH_BYTES: usize = 255;
 
-/// The boot's semihosting arguments (`trace=FILE`, `bench`, `overrun-at=N`, `reset-every=N`).
+/// The boot's semihosting arguments (`trace=FILE`, `bench`, `overrun-at=N`, `reset-every=N`,
+/// `trip-log=FILE`, `config=FILE`: the unit's configuration block, `monitor::config_block`).
 pub struct Args {
     /// Count instructions back to back instead of running in real time.
     pub bench: bool,
@@ -26,6 +28,7 @@ pub struct Args {
     pub reset_every: u32,
     path: [u8; PATH_BYTES + 1],
     trip_path: [u8; PATH_BYTES + 1],
+    config_path: [u8; PATH_BYTES + 1],
 }
 
 impl Args {
@@ -45,6 +48,7 @@ pub fn args() -> Args {
         reset_every: 0,
         path: [0; PATH_BYTES + 1],
         trip_path: [0; PATH_BYTES + 1],
+        config_path: [0; PATH_BYTES + 1],
     };
     if let Ok(args) = semihosting::experimental::env::args::<512>() {
         for arg in args.flatten() {
@@ -59,6 +63,11 @@ pub fn args() -> Args {
                 match a.trip_path.get_mut(..p.len()) {
                     Some(dst) if p.len() <= PATH_BYTES => dst.copy_from_slice(p.as_bytes()),
                     _ => fail("the trip log path is too long"),
+                }
+            } else if let Some(p) = arg.strip_prefix("config=") {
+                match a.config_path.get_mut(..p.len()) {
+                    Some(dst) if p.len() <= PATH_BYTES => dst.copy_from_slice(p.as_bytes()),
+                    _ => fail("the configuration block's path is too long"),
                 }
             } else if let Some(n) = arg.strip_prefix("overrun-at=") {
                 a.overrun_at = n.parse().unwrap_or(u32::MAX);
@@ -143,18 +152,46 @@ impl Stream {
     }
 }
 
-/// The monitor with the default configuration, announced with the run's mode.
+/// The unit's configuration: its block (`config=FILE`, what a flash page holds on a real part)
+/// or, without one, the uncommissioned defaults. A refused block stops the run.
+fn configuration(args: &Args) -> (Config, &'static str) {
+    let Some(path) = core::ffi::CStr::from_bytes_until_nul(&args.config_path)
+        .ok()
+        .filter(|p| !p.is_empty())
+    else {
+        return (Config::default(), "uncommissioned");
+    };
+    let Ok(mut file) = File::open(path) else {
+        fail("cannot open the configuration block")
+    };
+    let mut block = [0_u8; config_block::CONFIG_BLOCK_BYTES];
+    let mut n = 0;
+    while let Some(rest) = block.get_mut(n..).filter(|r| !r.is_empty()) {
+        match file.read(rest) {
+            Ok(0) | Err(_) => break,
+            Ok(k) => n += k,
+        }
+    }
+    match config_block::decode(block.get(..n).unwrap_or(&[])) {
+        Ok(c) => (c, "from its block"),
+        Err(_) => fail("the configuration block is refused (layout, checksum or a rejected value)"),
+    }
+}
+
+/// The monitor with the unit's configuration, announced with the run's mode.
 pub fn monitor(replay: &Streamed<'static>, args: &Args, board: &str) -> Monitor {
-    let Ok(monitor) = Monitor::new(Config::default()) else {
-        fail("the default monitor configuration was rejected")
+    let (config, source) = configuration(args);
+    let Ok(monitor) = Monitor::new(config) else {
+        fail("the monitor configuration was rejected")
     };
     defmt::info!(
-        "noback firmware {=str} on {=str}: {=u32} samples at {=u32} Hz, mode {=str}",
+        "noback firmware {=str} on {=str}: {=u32} samples at {=u32} Hz, mode {=str}, configuration {=str}",
         env!("CARGO_PKG_VERSION"),
         board,
         replay.len(),
         replay.tick_hz(),
-        if args.bench { "bench" } else { "realtime" }
+        if args.bench { "bench" } else { "realtime" },
+        source
     );
     monitor
 }

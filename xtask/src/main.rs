@@ -8,6 +8,7 @@ mod bench;
 mod board_pin;
 mod board_test;
 mod bootstrap;
+mod commission;
 mod cores;
 mod defmt_log;
 mod elf_size;
@@ -61,6 +62,8 @@ enum Cmd {
     Sweep(noback_twin::sweep::SweepArgs),
     /// The monitor against the twin on one scene or trace (accuracy, flags, latency).
     Monitor(monitor::MonitorArgs),
+    /// The unit's settings from its recorded acceptance run, as a configuration file.
+    Commission(commission::CommissionArgs),
     /// Detection by Monte Carlo; writes docs/monitor.md (its own options: see its --help).
     #[command(disable_help_flag = true)]
     MonitorMc(Passthrough),
@@ -156,6 +159,7 @@ fn dispatch(args: &[String]) -> i32 {
         Cmd::Sweep(a) => Ok(noback_twin::sweep::sweep_run(&a)),
         Cmd::TwinBench(_) => twin_bench::main(rest),
         Cmd::Monitor(a) => monitor::main(&a),
+        Cmd::Commission(a) => commission::main(&a),
         Cmd::MonitorMc(a) => monitor_mc::main(&a.args),
         Cmd::Fuzz(a) => fuzz::main(&a),
         Cmd::Golden => golden::main(),

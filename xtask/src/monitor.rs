@@ -36,6 +36,14 @@ pub struct MonitorArgs {
     pub out: PathBuf,
 }
 
+/// Reads a configuration file; the error names the file and the key.
+pub fn config_from_file(path: &std::path::Path) -> Result<Config, String> {
+    std::fs::read_to_string(path)
+        .map_err(|e| e.to_string())
+        .and_then(|t| host_tests::config_file::parse(&t))
+        .map_err(|e| format!("{}: {e}", path.display()))
+}
+
 /// Entry.
 pub fn main(a: &MonitorArgs) -> Result<i32, String> {
     let (target, json_out, out) = (a.target.clone(), a.json, a.out.clone());
@@ -62,12 +70,9 @@ pub fn main(a: &MonitorArgs) -> Result<i32, String> {
     };
     let config = match &a.config {
         None => Config::default(),
-        Some(path) => match std::fs::read_to_string(path)
-            .map_err(|e| e.to_string())
-            .and_then(|t| host_tests::config_file::parse(&t))
-        {
+        Some(path) => match config_from_file(path) {
             Ok(c) => c,
-            Err(e) => return Ok(bad_input("monitor", &format!("{}: {e}", path.display()))),
+            Err(e) => return Ok(bad_input("monitor", &e)),
         },
     };
     let estimates = run_monitor(&trace, config)?;

@@ -83,16 +83,17 @@ pub struct HostRun {
     pub totals: Totals,
 }
 
-/// Steps the default monitor over a replay on the host, applying the same missed deadlines
+/// Steps the monitor (with `config`) over a replay on the host, applying the same missed deadlines
 /// the firmware reported (`(ticks stepped before it, ticks missed)`) and the same operator
 /// resets (after every `reset_every`-th tick), so both see identical inputs.
 pub fn host_run(
     bytes: &[u8],
     overruns: &[(u32, u32)],
     reset_every: Option<u32>,
+    config: Config,
 ) -> Result<HostRun, String> {
     let replay = Replay::parse(bytes).map_err(|e| format!("replay: {e:?}"))?;
-    let monitor = Monitor::new(Config::default()).map_err(|e| format!("monitor: {e:?}"))?;
+    let monitor = Monitor::new(config).map_err(|e| format!("monitor: {e:?}"))?;
     let mut ticker = Ticker::new(monitor, replay, HostPin::default());
     let mut estimates = Vec::new();
     loop {

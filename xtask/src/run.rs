@@ -14,7 +14,8 @@ use crate::qemu::{self, Boot, Outcome};
 use crate::replay::{host_run, nbr1, stress_trace, twin_trace, STRESS};
 use crate::shell::{self, cargo, workspace_root};
 use crate::{bootstrap, elf_size};
-use noback::monitor::Flags;
+use noback::monitor::config_block::{self, CONFIG_BLOCK_BYTES};
+use noback::monitor::{Config, Flags};
 use serde_json::json;
 use std::collections::BTreeMap;
 
@@ -44,6 +45,10 @@ pub struct RunArgs {
     /// Print the summary as one JSON object.
     #[arg(long)]
     pub json: bool,
+    /// The monitor's configuration file (docs/monitor-design.md, "Configuration file"), handed
+    /// to the firmware as its configuration block; default: uncommissioned.
+    #[arg(long, value_name = "FILE")]
+    pub config: Option<std::path::PathBuf>,
     /// Burn time in this tick to provoke a missed deadline (the overrun test).
     #[arg(long, value_name = "TICK", allow_hyphen_values = true)]
     pub overrun_at: Option<u32>,
@@ -116,11 +121,21 @@ pub fn main(a: &RunArgs) -> Result<i32, String> {
     bootstrap::ensure_all()?;
     let reset_every = (a.scene == STRESS).then_some(STRESS_RESET_EVERY);
     let core = a.board.unwrap_or(a.core);
-    let (report, ok) = match replay_report(&a.scene, core, a.overrun_at, reset_every, !a.json) {
-        // The twin failing on a scene that passed the schema is still the scene's fault.
-        Err(e) if e.starts_with("twin: ") => return Ok(noback_twin::args::bad_input("run", &e)),
-        other => other?,
+    let config = match &a.config {
+        None => None,
+        Some(path) => match crate::monitor::config_from_file(path) {
+            Ok(c) => Some(c),
+            Err(e) => return Ok(noback_twin::args::bad_input("run", &e)),
+        },
     };
+    let (report, ok) =
+        match replay_report_with(&a.scene, core, a.overrun_at, reset_every, !a.json, config) {
+            // The twin failing on a scene that passed the schema is still the scene's fault.
+            Err(e) if e.starts_with("twin: ") => {
+                return Ok(noback_twin::args::bad_input("run", &e))
+            }
+            other => other?,
+        };
     if a.json {
         println!("{report}");
     } else {
@@ -137,6 +152,19 @@ pub fn replay_report(
     overrun_at: Option<u32>,
     reset_every: Option<u32>,
     echo: bool,
+) -> Result<(serde_json::Value, bool), String> {
+    replay_report_with(scene, core, overrun_at, reset_every, echo, None)
+}
+
+/// [`replay_report`] with the firmware given a configuration block (`config=FILE`) and the
+/// host's monitor the same configuration.
+pub fn replay_report_with(
+    scene: &str,
+    core: Core,
+    overrun_at: Option<u32>,
+    reset_every: Option<u32>,
+    echo: bool,
+    config: Option<Config>,
 ) -> Result<(serde_json::Value, bool), String> {
     let trace = if scene == STRESS {
         stress_trace()
@@ -166,6 +194,15 @@ pub fn replay_report(
     let elf = build(core)?;
     let trace_arg = format!("trace={}", replay_path.display());
     let mut rt_args = vec!["realtime".to_string(), trace_arg.clone()];
+    let mut bench_args = vec!["bench".to_string(), trace_arg];
+    if let Some(c) = &config {
+        let mut block = [0_u8; CONFIG_BLOCK_BYTES];
+        let n = config_block::encode(c, &mut block).map_err(|e| format!("config block: {e:?}"))?;
+        let path = dir.join(format!("{stem}.nbc1"));
+        std::fs::write(&path, &block[..n]).map_err(|e| e.to_string())?;
+        rt_args.push(format!("config={}", path.display()));
+        bench_args.push(format!("config={}", path.display()));
+    }
     // The evaluation boards' image writes its trip log's region here at the end.
     let region = dir.join(format!("{stem}-{}.flash", core.name()));
     let _ = std::fs::remove_file(&region);
@@ -187,14 +224,7 @@ pub fn replay_report(
         Vec::new()
     };
     let realtime = boot(core, &elf, REALTIME_SHIFT, rt_args, echo, &rt_extra)?;
-    let bench = boot(
-        core,
-        &elf,
-        BENCH_SHIFT,
-        vec!["bench".into(), trace_arg],
-        false,
-        &[],
-    )?;
+    let bench = boot(core, &elf, BENCH_SHIFT, bench_args, false, &[])?;
 
     let summary = line_with(&realtime.lines, "summary")?;
     let bench_line = line_with(&bench.lines, "bench")?;
@@ -207,8 +237,9 @@ pub fn replay_report(
             Ok((field(&f, "tick")?, field(&f, "missed")?))
         })
         .collect::<Result<_, String>>()?;
-    let host = host_run(&bytes, &overruns, reset_every)?;
-    let host_plain = host_run(&bytes, &[], None)?;
+    let config = config.unwrap_or_default();
+    let host = host_run(&bytes, &overruns, reset_every, config)?;
+    let host_plain = host_run(&bytes, &[], None, config)?;
     let fw_digest = hex(&summary, "digest")?;
     let bench_digest = hex(&bench_line, "digest")?;
     let bit_exact = fw_digest == host.totals.digest && bench_digest == host_plain.totals.digest;
@@ -308,6 +339,16 @@ pub fn replay_report(
     } else {
         (serde_json::Value::Null, true)
     };
+    // What the firmware announced it runs on: its block, or the uncommissioned defaults.
+    let configuration = if realtime
+        .lines
+        .iter()
+        .any(|l| l.contains("configuration from its block"))
+    {
+        "block"
+    } else {
+        "uncommissioned"
+    };
     let report = json!({
         "scene": scene,
         "core": core.name(),
@@ -336,6 +377,7 @@ pub fn replay_report(
         "ram_bytes": size.ram_bytes,
         "stack_bytes_max": stack_bytes,
         "bit_exact": bit_exact,
+        "configuration": configuration,
         "firmware_digest": format!("{fw_digest:#010x}"),
         "fx_selfcheck_digest": format!("{:#010x}", crate::test::digest_in(&realtime.lines)?),
         "host_digest": format!("{:#010x}", host.totals.digest),

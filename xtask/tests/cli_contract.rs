@@ -59,6 +59,7 @@ const COMMANDS: &[&str] = &[
     "paper",
     "sweep",
     "monitor",
+    "commission",
     "monitor-mc",
     "fuzz",
     "golden",
@@ -275,6 +276,42 @@ fn bad_traces_are_refused_by_monitor() {
         refused(&["monitor", &path], named);
         refused(&["monitor", &path], name);
     }
+}
+
+#[test]
+fn commission_refuses_runs_that_cannot_identify_the_settings() {
+    // No drive cut; a flag raised (a stuck output encoder); too short a drive.
+    refused(&["commission", "drive"], "no drive cut");
+    let stuck = file(
+        "stuck.toml",
+        "[scene]\nkind = \"reverse_load\"\n[[fault]]\nkind = \"encoder_stuck\"\nat_s = 0.15\nseverity = 1.0\n",
+    );
+    refused(&["commission", &stuck], "not a healthy run");
+    let short = file(
+        "short.toml",
+        "[scene]\nkind = \"reverse_load\"\nrelease_at_s = 0.1\n",
+    );
+    refused(&["commission", &short], "at least 0.2 s");
+    refused(&["commission", "reverse_load", "--load-nm", "nan"], "NaN");
+    let trace = file(
+        "acceptance.csv",
+        "# noback-trace v1\n# sample_rate_hz=10000\nt_s,current_code,motor_count,output_count,drive_on,pressing_force_n,braking_torque_nm,output_speed_rad_s,input_speed_rad_s,output_angle_rad,brake_state\n0.0,2048,0,0,1,0,0,0,0,0,0\n0.0001,2048,0,0,1,0,0,0,0,0,0\n",
+    );
+    refused(&["commission", &trace], "--load-nm");
+    refused(
+        &[
+            "commission",
+            "reverse_load",
+            "forward_load",
+            "--load-nm",
+            "20",
+        ],
+        "one per run",
+    );
+    refused(
+        &["run", "--config", "/nonexistent.toml"],
+        "nonexistent.toml",
+    );
 }
 
 #[test]

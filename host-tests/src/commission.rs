@@ -1,0 +1,363 @@
+//! Commissioning (docs/monitor-design.md, "Configuration file and commissioning"): the plant
+//! facts the uncommissioned monitor cannot know, identified from the unit's acceptance runs —
+//! each: the drive turns the door against (opening) or with (closing) a known load at a steady
+//! speed, is cut, and the brake holds the door; two opening runs at different loads also give
+//! the current's gain.
+//!
+//! | identified | from | sets |
+//! |---|---|---|
+//! | current offset | the current reading over the final hold, drive off | `current_offset_a` |
+//! | current gain (two runs or more, loads ≥ 5 N·m apart) | slope of the steady drive torque over the load | `sensors.motor_torque_constant_nm_a` |
+//! | pack drag while driving | steady drive torque / gain − the load | `sliding_mu` (spring-only, or no closing run) |
+//! | overrunning equilibrium (a closing run) | `y = L + v` against `g₁(μ)·v − g₀(μ)` | `sliding_mu` (relieved) |
+//! | braking against the load | the output's deceleration to its turning point: `J·α − M` | `braking_share` (0.8 × its share of the capacity) |
+//! | form | that braking over the drag: the ramps clamp from the cut (> 3) or it is the drag alone (≈ 1) | `driving_pack`, braking-angle allowance, dead-current check |
+//!
+//! The pack's static capacity is not identified: it needs the brake made to slip (a functional
+//! test, issue 17); `capacity_mu` stays at Table 2's μ_s.
+
+use crate::accuracy::run_monitor;
+use noback::mechanism::Mechanism;
+use noback::monitor::{Config, DrivingPack, Thresholds};
+use noback_twin::trace::Trace;
+
+/// Steady drive averaged before the cut (s), ending [`CUT_GUARD_S`] before it.
+pub const STEADY_WINDOW_S: f64 = 0.1;
+/// Gap between the steady window and the cut (s).
+pub const CUT_GUARD_S: f64 = 0.005;
+/// Shortest drive before the cut (s): the steady window then starts after the drive's start-up.
+pub const MIN_DRIVE_S: f64 = 0.2;
+/// Shortest hold at the end of the run (s): the output still within [`HOLD_CREEP_RAD`].
+pub const MIN_HOLD_S: f64 = 0.1;
+/// Output travel allowed over the final hold (rad): a few encoder counts of rattle.
+pub const HOLD_CREEP_RAD: f64 = 0.005;
+/// Slowest steady drive (rad/s at the output) and largest speed ripple over the window (share).
+pub const MIN_SPEED_RAD_S: f64 = 1.0;
+/// Largest speed ripple over the window, as a share of the mean speed.
+pub const MAX_RIPPLE: f64 = 0.05;
+/// Braking against the load, over the drag while driving, above which the ramps clamp from the
+/// cut (`DrivingPack::Relieved`: 55–67 × on the physical reading from 35 to 20 N·m); a pack
+/// they leave open brakes with its drag alone (≈ 1 ×).
+pub const CLAMPS_AT_ONCE: f64 = 3.0;
+/// Share of the measured opposed braking the commissioned envelope counts on: margin for the
+/// inertia (Table 2 ± 10 %) and the load the crew applied.
+pub const BRAKING_SHARE_MARGIN: f64 = 0.8;
+
+/// Two acceptance runs' loads must differ by this much (N·m) to identify the current's gain.
+pub const MIN_LOAD_SPAN_NM: f64 = 5.0;
+/// Plausible range of the identified gain (measured drive torque over true).
+pub const GAIN_RANGE: (f64, f64) = (0.5, 2.0);
+
+/// What one acceptance run showed.
+#[derive(Clone, Debug, PartialEq)]
+pub struct RunFigures {
+    pub load_nm: f64,
+    pub cut_s: f64,
+    pub drive_speed_rad_s: f64,
+    /// Mean drive torque over the steady window (N·m, signed: negative against the load).
+    pub drive_torque_nm: f64,
+    /// Whether the drive turned the output with the load (closing) rather than against it.
+    pub closing: bool,
+    /// Mean current reading over the final hold, drive off (A).
+    pub hold_current_a: f64,
+    pub braking_time_s: f64,
+    pub braking_nm: f64,
+    pub braking_share: f64,
+}
+
+/// What the acceptance runs showed, and the configuration set from them.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Commissioning {
+    pub runs: Vec<RunFigures>,
+    /// Measured over true drive torque (1 unless two loads were run).
+    pub gain: f64,
+    pub current_offset_a: f64,
+    pub drive_drag_nm: f64,
+    pub braking_share: f64,
+    pub config: Config,
+}
+
+fn mean(x: impl Iterator<Item = f64>) -> f64 {
+    let (s, n) = x.fold((0.0, 0usize), |(s, n), v| (s + v, n + 1));
+    s / n.max(1) as f64
+}
+
+/// The output angle (rad) of every row, unwrapped from the encoder's counts.
+fn output_angles(trace: &Trace, c: &Config) -> Vec<f64> {
+    let bits = c.sensors.output_encoder_bits;
+    let modulus = 1_i64 << bits;
+    let rad = core::f64::consts::TAU / modulus as f64;
+    let mut turns = 0_i64;
+    let mut prev = None;
+    trace
+        .rows
+        .iter()
+        .map(|r| {
+            let n = i64::from(r.output_count);
+            if let Some(p) = prev {
+                let d: i64 = n - p;
+                if d > modulus / 2 {
+                    turns -= modulus;
+                } else if d < -modulus / 2 {
+                    turns += modulus;
+                }
+            }
+            prev = Some(n);
+            (n + turns) as f64 * rad
+        })
+        .collect()
+}
+
+/// One run's figures, the monitor set with `base`; refuses a run that cannot give them.
+fn measure(trace: &Trace, load_nm: f64, base: Config) -> Result<RunFigures, String> {
+    if !(load_nm.is_finite() && load_nm >= base.thresholds.min_load_nm * 2.0) {
+        return Err(format!(
+            "the load {load_nm} N·m is below the {} N·m the identification needs",
+            base.thresholds.min_load_nm * 2.0
+        ));
+    }
+    let estimates = run_monitor(trace, base)?;
+    let dt = 1.0 / trace.sample_rate_hz;
+    if let Some((i, e)) = estimates
+        .iter()
+        .enumerate()
+        .find(|(_, e)| e.flags.bits() != 0)
+    {
+        return Err(format!(
+            "the uncommissioned monitor raised {:?} at {:.4} s: not a healthy run",
+            e.flags,
+            i as f64 * dt
+        ));
+    }
+    let rows = &trace.rows;
+    let cut = rows
+        .windows(2)
+        .position(|w| w[0].drive_on && !w[1].drive_on)
+        .map(|i| i + 1)
+        .ok_or("no drive cut: the run must drive, then cut the drive")?;
+    if rows[..cut].iter().any(|r| !r.drive_on) || (cut as f64) * dt < MIN_DRIVE_S {
+        return Err(format!(
+            "the drive must run from the start for at least {MIN_DRIVE_S} s before the cut"
+        ));
+    }
+    if rows[cut..].iter().any(|r| r.drive_on) {
+        return Err("the drive comes back on after the cut".into());
+    }
+    let theta = output_angles(trace, &base);
+    let hold = (MIN_HOLD_S / dt) as usize;
+    let end = rows.len() - 1;
+    if end < cut + hold
+        || theta[end - hold..]
+            .iter()
+            .any(|t| (t - theta[end]).abs() > HOLD_CREEP_RAD)
+    {
+        return Err(format!(
+            "no hold: the output must stay still for the last {MIN_HOLD_S} s"
+        ));
+    }
+    let (w1, w0) = (
+        cut - (CUT_GUARD_S / dt) as usize,
+        cut - ((CUT_GUARD_S + STEADY_WINDOW_S) / dt) as usize,
+    );
+    let speed = (theta[w1] - theta[w0]) / ((w1 - w0) as f64 * dt);
+    let tenth = (w1 - w0) / 10;
+    let ripple = (0..10)
+        .map(|k| {
+            let (a, b) = (w0 + k * tenth, w0 + (k + 1) * tenth);
+            ((theta[b] - theta[a]) / (tenth as f64 * dt) - speed).abs()
+        })
+        .fold(0.0, f64::max);
+    if speed.abs() < MIN_SPEED_RAD_S {
+        return Err(format!(
+            "the output must turn at {MIN_SPEED_RAD_S} rad/s or more before the cut; it turned at {speed:.3} rad/s"
+        ));
+    }
+    if ripple > MAX_RIPPLE * speed.abs() {
+        return Err(format!(
+            "the drive is not steady over the {STEADY_WINDOW_S} s before the cut (speed ripple {ripple:.3} rad/s)"
+        ));
+    }
+    let drive_torque = mean(
+        estimates[w0..w1]
+            .iter()
+            .map(|e| e.drive_torque_nm.to_num::<f64>()),
+    );
+    let s = &base.sensors;
+    let mid = f64::from(1_u32 << (s.current_adc_bits - 1));
+    let hold_current = mean(
+        rows[end - hold..]
+            .iter()
+            .map(|r| (f64::from(r.current_code) - mid) * s.amps_per_count()),
+    );
+    // Braking: from the cut to the output's turning point (the first sample at the far end of
+    // its travel).
+    let dir = speed.signum();
+    let stop = cut
+        + theta[cut..]
+            .iter()
+            .enumerate()
+            .min_by(|a, b| (-dir * a.1).total_cmp(&(-dir * b.1)))
+            .map_or(0, |(i, _)| i);
+    let braking_time = (stop - cut) as f64 * dt;
+    if braking_time <= 2.0 * dt {
+        return Err("the output did not move after the cut".into());
+    }
+    let m: &Mechanism = &base.mechanism;
+    // The pack's torque: the deceleration's, less the load's share (it opposes an opening).
+    let opposed = m.output_inertia_kg_m2 * (speed.abs() / braking_time) + dir * load_nm;
+    let capacity = m.pack_capacity_nm(m.quasi_static_pressing_force_n(load_nm), base.capacity_mu);
+    Ok(RunFigures {
+        load_nm,
+        cut_s: cut as f64 * dt,
+        drive_speed_rad_s: speed,
+        drive_torque_nm: drive_torque,
+        closing: speed > 0.0,
+        hold_current_a: hold_current,
+        braking_time_s: braking_time,
+        braking_nm: opposed,
+        braking_share: opposed / capacity,
+    })
+}
+
+/// Identifies the unit's settings from its acceptance runs, each `(trace, load the crew
+/// applied)`. One run: the current's gain is taken as nominal. Two or more at loads
+/// [`MIN_LOAD_SPAN_NM`] apart: the gain is the slope of drive torque over load. A run that cannot
+/// identify them is refused with the reason (naming the run when there are several).
+pub fn commission(runs: &[(&Trace, f64)]) -> Result<Commissioning, String> {
+    let name = |i: usize| {
+        if runs.len() > 1 {
+            format!("run {}: ", i + 1)
+        } else {
+            String::new()
+        }
+    };
+    let first = runs.first().ok_or("no acceptance run")?;
+    // The offset first (drive off in the hold), so the drive torques are read without it.
+    let mut base = Config::default();
+    let offset = measure(first.0, first.1, base).map_err(|e| name(0) + &e)?;
+    base.current_offset_a = offset.hold_current_a;
+    let figures = runs
+        .iter()
+        .enumerate()
+        .map(|(i, (t, load))| measure(t, *load, base).map_err(|e| name(i) + &e))
+        .collect::<Result<Vec<_>, _>>()?;
+    let opening: Vec<&RunFigures> = figures.iter().filter(|f| !f.closing).collect();
+    if opening.is_empty() {
+        return Err("no run opens against the load: the drag and the form need one".into());
+    }
+    // Drive torque against the load: −D̂ = g·(M + drag), one line through the opening runs.
+    let (lo, hi) = opening
+        .iter()
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), f| {
+            (lo.min(f.load_nm), hi.max(f.load_nm))
+        });
+    let gain = if hi - lo >= MIN_LOAD_SPAN_NM {
+        let lm = mean(opening.iter().map(|f| f.load_nm));
+        let dm = mean(opening.iter().map(|f| -f.drive_torque_nm));
+        let sxy: f64 = opening
+            .iter()
+            .map(|f| (f.load_nm - lm) * (-f.drive_torque_nm - dm))
+            .sum();
+        let sxx: f64 = opening.iter().map(|f| (f.load_nm - lm).powi(2)).sum();
+        sxy / sxx
+    } else if opening.len() > 1 {
+        return Err(format!(
+            "the opening runs' loads must span at least {MIN_LOAD_SPAN_NM} N·m to identify the current's gain"
+        ));
+    } else {
+        1.0
+    };
+    if !(GAIN_RANGE.0..=GAIN_RANGE.1).contains(&gain) {
+        return Err(format!(
+            "the drive torque grows {gain:.3} times the load: not a healthy drive (are the loads right?)"
+        ));
+    }
+    let drag = mean(
+        opening
+            .iter()
+            .map(|f| -f.drive_torque_nm / gain - f.load_nm),
+    );
+    if drag <= 0.0 {
+        return Err(format!(
+            "the drive took {:.3} N·m against a load of {} N·m: no drag left for the pack (is the load right?)",
+            -opening[0].drive_torque_nm, opening[0].load_nm
+        ));
+    }
+    let heaviest = opening
+        .iter()
+        .max_by(|a, b| a.load_nm.total_cmp(&b.load_nm))
+        .ok_or("no acceptance run")?;
+    let relieved = heaviest.braking_nm > CLAMPS_AT_ONCE * drag;
+    let m = &base.mechanism;
+    let (spring, k) = (m.spring_preload_n(), m.ramp_factor_per_m());
+    // a = μ·c: from a closing run's overrunning equilibrium y = L + v = g₁(a)·v − g₀(a) where
+    // there is one (what the closing estimate rests on), else from the drag, drag = a·F.
+    let closing = figures.iter().find(|f| f.closing);
+    let a = match (relieved, closing) {
+        (true, Some(f)) => {
+            let v = f.drive_torque_nm / gain;
+            let y = f.load_nm + v;
+            let den = y * k - 2.0 * k * v + spring;
+            if !(v > 0.0 && den > 0.0) {
+                return Err(format!(
+                    "the closing run's drive torque {v:.3} N·m at {} N·m is no overrunning equilibrium",
+                    f.load_nm
+                ));
+            }
+            y / den
+        }
+        (true, None) => {
+            let room = spring - drag * k;
+            if room <= 0.0 {
+                return Err(format!(
+                    "a drag of {drag:.3} N·m is more than a pack the drive relieves can give (≤ {:.3} N·m)",
+                    spring / k
+                ));
+            }
+            drag / room
+        }
+        (false, _) => drag / spring,
+    };
+    let mut config = configured(base, a, heaviest.braking_share, relieved);
+    // The monitor's torque per amp, so that its drive torque reads true.
+    config.sensors.motor_torque_constant_nm_a /= gain;
+    config.commissioned = true;
+    noback::monitor::Monitor::new(config).map_err(|e| format!("the identified settings: {e}"))?;
+    Ok(Commissioning {
+        runs: figures.clone(),
+        gain,
+        current_offset_a: config.current_offset_a,
+        drive_drag_nm: drag,
+        braking_share: heaviest.braking_share,
+        config,
+    })
+}
+
+/// The configuration for a pack with `a = μ·c` while slipping, whose measured braking against the
+/// load is `share` of its capacity, and which the ramps clamp from the cut (`relieved`) or not.
+fn configured(base: Config, a: f64, share: f64, relieved: bool) -> Config {
+    let mut cfg = base;
+    cfg.sliding_mu = a / base.mechanism.pack_torque_per_newton_m(1.0);
+    cfg.driving_pack = if relieved {
+        DrivingPack::Relieved
+    } else {
+        DrivingPack::SpringOnly
+    };
+    let t = if relieved {
+        Thresholds::PHYSICAL_READING
+    } else {
+        Thresholds::DEFAULT
+    };
+    cfg.thresholds.braking_angle_allowance_rad = t.braking_angle_allowance_rad;
+    cfg.thresholds.opposed_braking_share = (share * BRAKING_SHARE_MARGIN).clamp(0.0, 1.0);
+    // The dead-reading check needs a drive torque that never falls near zero while the output
+    // turns: a relieved pack's drag (a·F_s/(1 + a·k)); a spring-only pack closes on almost none.
+    let m = &base.mechanism;
+    let drag = a * m.spring_preload_n() / (1.0 + a * m.ramp_factor_per_m());
+    cfg.thresholds.dead_current_nm = if relieved {
+        (drag / 4.0).min(t.dead_current_nm)
+    } else {
+        0.0
+    };
+    cfg
+}

@@ -1,0 +1,144 @@
+//! Commissioning (docs/monitor-design.md, "Commissioning") tested on runs it did not see: set
+//! from one acceptance run of each reading, evaluated on other loads, speeds, current noise and
+//! noise seeds, and on closing runs.
+
+use host_tests::accuracy::{compare, run_monitor, scene_trace};
+use host_tests::commission::commission;
+use noback::monitor::DrivingPack;
+use noback_twin::reading::Reading;
+use noback_twin::scene::{Scene, SceneKind};
+
+fn scene(kind: SceneKind, reading: Reading, load: f64, speed: f64, noise: (u64, f64)) -> Scene {
+    let mut s = Scene::builtin(kind, reading);
+    s.load_torque_nm = load;
+    s.initial_speed_rad_s = speed;
+    s.noise.seed = noise.0;
+    s.noise.current_noise_a = noise.1;
+    s
+}
+
+#[test]
+fn settings_from_one_run_hold_on_runs_it_did_not_see() {
+    for (reading, form) in [
+        (Reading::Paper, DrivingPack::SpringOnly),
+        (Reading::Physical, DrivingPack::Relieved),
+    ] {
+        let acceptance = scene(SceneKind::ReverseLoad, reading, 20.3, 13.78, (1, 0.0));
+        let c = commission(&[(&scene_trace(&acceptance).unwrap(), 20.3)]).unwrap();
+        assert_eq!(c.config.driving_pack, form, "{reading:?}");
+        assert!(c.config.commissioned);
+        for (load, speed, noise) in [(12.0, 9.0, (7, 0.05)), (30.0, 13.78, (11, 0.05))] {
+            let s = scene(SceneKind::ReverseLoad, reading, load, speed, noise);
+            let trace = scene_trace(&s).unwrap();
+            let acc = compare(&trace, &run_monitor(&trace, c.config).unwrap());
+            let what = format!("{reading:?} reverse_load {load} N·m at {speed} rad/s");
+            assert!(acc.flags.is_empty(), "{what}: {:?}", acc.flags);
+            let err = acc.holding_torque_err_pct().unwrap();
+            assert!(err <= 2.0, "{what}: holding torque off by {err:.2} %");
+        }
+        let s = scene(SceneKind::ForwardLoad, reading, 25.0, 11.0, (3, 0.05));
+        let trace = scene_trace(&s).unwrap();
+        let acc = compare(&trace, &run_monitor(&trace, c.config).unwrap());
+        assert!(
+            acc.flags.is_empty(),
+            "{reading:?} forward_load: {:?}",
+            acc.flags
+        );
+    }
+}
+
+/// A unit whose current reads 8 % high through the motor constant, 2 % through the sensor, with
+/// 0.2 A of offset and a reducer at 85 %: two acceptance runs identify gain and offset.
+#[test]
+fn two_loads_identify_the_current_gain_and_offset() {
+    let unit = |s: &mut Scene| {
+        s.sensors.motor_torque_constant_nm_a *= 0.92;
+        s.sensors.reducer_efficiency = 0.85;
+        s.noise.current_gain = 1.02;
+        s.noise.current_offset_a = 0.2;
+    };
+    for reading in [Reading::Paper, Reading::Physical] {
+        let runs: Vec<_> = [20.3, 8.0]
+            .iter()
+            .map(|&load| {
+                let mut s = scene(SceneKind::ReverseLoad, reading, load, 13.78, (5, 0.02));
+                unit(&mut s);
+                (scene_trace(&s).unwrap(), load)
+            })
+            .collect();
+        let pairs: Vec<_> = runs.iter().map(|(t, l)| (t, *l)).collect();
+        let c = commission(&pairs).unwrap();
+        assert!(
+            (c.current_offset_a - 0.2).abs() < 0.02,
+            "{reading:?}: offset {}",
+            c.current_offset_a
+        );
+        for load in [12.0, 24.0] {
+            let mut s = scene(SceneKind::ReverseLoad, reading, load, 10.0, (9, 0.02));
+            unit(&mut s);
+            let trace = scene_trace(&s).unwrap();
+            let acc = compare(&trace, &run_monitor(&trace, c.config).unwrap());
+            let one = commission(&pairs[..1]).map(|c| {
+                compare(&trace, &run_monitor(&trace, c.config).unwrap())
+                    .holding_torque_err_pct()
+                    .unwrap()
+            });
+            let err = acc.holding_torque_err_pct().unwrap();
+            println!(
+                "{reading:?} {load} N·m: gain {:.4}, holding error {err:.2} % (one run: {one:?})",
+                c.gain
+            );
+            assert!(acc.flags.is_empty(), "{reading:?} {load}: {:?}", acc.flags);
+            assert!(
+                err <= 2.0,
+                "{reading:?} {load} N·m: holding torque off by {err:.2} %"
+            );
+        }
+    }
+}
+
+/// A closing run in the acceptance cycle sets the overrunning equilibrium the closing estimate
+/// rests on: the physical reading's forward_load at other loads and speeds within 2 %.
+#[test]
+fn a_closing_run_sets_the_overrunning_estimate() {
+    let reading = Reading::Physical;
+    let runs: Vec<_> = [
+        (SceneKind::ReverseLoad, 20.3),
+        (SceneKind::ReverseLoad, 8.0),
+        (SceneKind::ForwardLoad, 20.3),
+    ]
+    .iter()
+    .map(|&(kind, load)| {
+        let s = scene(kind, reading, load, 13.78, (2, 0.02));
+        (scene_trace(&s).unwrap(), load)
+    })
+    .collect();
+    let pairs: Vec<_> = runs.iter().map(|(t, l)| (t, *l)).collect();
+    let c = commission(&pairs).unwrap();
+    assert!(c.runs[2].closing && c.config.driving_pack == DrivingPack::Relieved);
+    for (load, speed) in [(10.0, 8.0), (28.0, 12.0)] {
+        let s = scene(SceneKind::ForwardLoad, reading, load, speed, (13, 0.02));
+        let trace = scene_trace(&s).unwrap();
+        let acc = compare(&trace, &run_monitor(&trace, c.config).unwrap());
+        let err = acc.holding_torque_err_pct().unwrap();
+        println!("forward_load {load} N·m at {speed} rad/s: holding error {err:.2} %");
+        assert!(acc.flags.is_empty(), "{load}: {:?}", acc.flags);
+        assert!(
+            err <= 2.0,
+            "forward_load {load} N·m: holding torque off by {err:.2} %"
+        );
+    }
+}
+
+#[test]
+fn a_run_with_the_wrong_load_is_refused_or_misread_openly() {
+    // The crew's load above what the drive took leaves no drag: refused, naming the load.
+    let t = scene_trace(&Scene::builtin(SceneKind::ReverseLoad, Reading::Physical)).unwrap();
+    let e = commission(&[(&t, 40.0)]).unwrap_err();
+    assert!(e.contains("load"), "{e}");
+    let e = commission(&[(&t, 0.5)]).unwrap_err();
+    assert!(e.contains("below"), "{e}");
+    // Two runs must span enough load to give the gain.
+    let e = commission(&[(&t, 20.3), (&t, 21.0)]).unwrap_err();
+    assert!(e.contains("span"), "{e}");
+}

@@ -1,0 +1,130 @@
+//! `cargo xtask commission RUN [RUN…] [--load-nm L]… [--out FILE] [--json]` — the unit's
+//! settings from its recorded acceptance runs (`host_tests::commission`), written as the
+//! monitor's configuration file (`host_tests::config_file`).
+
+use crate::replay::twin_trace;
+use noback_twin::args::bad_input;
+use noback_twin::trace::Trace;
+use serde_json::json;
+use std::path::PathBuf;
+
+/// `cargo xtask commission`'s options.
+#[derive(clap::Args, Debug)]
+pub struct CommissionArgs {
+    /// The acceptance runs, each a built-in scene, a TOML scene file or a recorded trace
+    /// (`.csv`): the drive opens against a known load, is cut, and the brake holds; two at loads
+    /// 5 N·m or more apart also give the current's gain (docs/monitor-design.md).
+    #[arg(value_name = "SCENE|FILE|TRACE.csv", required = true)]
+    pub targets: Vec<String>,
+    /// The load the crew applied in each run, in order (N·m); a scene's own load when not given,
+    /// required for a trace.
+    #[arg(long, value_name = "NM", allow_hyphen_values = true)]
+    pub load_nm: Vec<f64>,
+    /// Where the configuration file goes (default: printed).
+    #[arg(long, value_name = "FILE")]
+    pub out: Option<PathBuf>,
+    /// Print what was identified as one JSON object.
+    #[arg(long)]
+    pub json: bool,
+}
+
+/// Reads one acceptance run: its trace and, for a scene, its own load.
+fn acceptance_run(target: &str) -> Result<(Trace, Option<f64>), String> {
+    let name = noback_twin::args::short(target);
+    if target.ends_with(".csv") {
+        return Trace::read(std::path::Path::new(target))
+            .map(|t| (t, None))
+            .map_err(|e| format!("{name}: {e}"));
+    }
+    let scene = noback_twin::cli::load_scene(target, None)?;
+    Ok((twin_trace(target)?, Some(scene.load_torque_nm)))
+}
+
+/// Entry.
+pub fn main(a: &CommissionArgs) -> Result<i32, String> {
+    if !a.load_nm.is_empty() && a.load_nm.len() != a.targets.len() {
+        return Ok(bad_input(
+            "commission",
+            &format!(
+                "--load-nm: {} given for {} runs (one per run, in order)",
+                a.load_nm.len(),
+                a.targets.len()
+            ),
+        ));
+    }
+    let mut runs = Vec::new();
+    for (i, target) in a.targets.iter().enumerate() {
+        let (trace, scene_load) = match acceptance_run(target) {
+            Ok(r) => r,
+            Err(e) => return Ok(bad_input("commission", &e)),
+        };
+        let Some(load) = a.load_nm.get(i).copied().or(scene_load) else {
+            return Ok(bad_input(
+                "commission",
+                &format!(
+                    "{}: a trace needs --load-nm, the load the crew applied",
+                    noback_twin::args::short(target)
+                ),
+            ));
+        };
+        runs.push((trace, load));
+    }
+    let pairs: Vec<(&Trace, f64)> = runs.iter().map(|(t, l)| (t, *l)).collect();
+    let c = match host_tests::commission::commission(&pairs) {
+        Ok(c) => c,
+        Err(e) => return Ok(bad_input("commission", &e)),
+    };
+    let loads: Vec<String> = runs.iter().map(|(_, l)| format!("{l}")).collect();
+    let comment = format!(
+        "cargo xtask commission {} (loads {} N·m): current offset {:.3} A, gain {:.4}, drag while driving {:.3} N·m, braking against the load {:.3} of capacity",
+        a.targets.iter().map(|t| noback_twin::args::short(t)).collect::<Vec<_>>().join(" "),
+        loads.join(", "),
+        c.current_offset_a,
+        c.gain,
+        c.drive_drag_nm,
+        c.braking_share
+    );
+    let text = host_tests::config_file::write(&c.config, &comment)?;
+    if let Some(path) = &a.out {
+        std::fs::write(path, &text).map_err(|e| format!("{}: {e}", path.display()))?;
+    }
+    if a.json {
+        let runs: Vec<_> = c
+            .runs
+            .iter()
+            .zip(&a.targets)
+            .map(|(f, t)| {
+                json!({
+                    "run": t,
+                    "load_nm": f.load_nm,
+                    "cut_s": f.cut_s,
+                    "drive_speed_rad_s": f.drive_speed_rad_s,
+                    "drive_torque_nm": f.drive_torque_nm,
+                    "hold_current_a": f.hold_current_a,
+                    "braking_time_s": f.braking_time_s,
+                    "braking_nm": f.braking_nm,
+                    "braking_share": f.braking_share,
+                    "closing": f.closing,
+                })
+            })
+            .collect();
+        println!(
+            "{}",
+            json!({
+                "runs": runs,
+                "current_offset_a": c.current_offset_a,
+                "gain": c.gain,
+                "drive_drag_nm": c.drive_drag_nm,
+                "braking_share": c.braking_share,
+                "sliding_mu": c.config.sliding_mu,
+                "driving_pack": format!("{:?}", c.config.driving_pack),
+                "config_file": text,
+            })
+        );
+    } else if a.out.is_none() {
+        print!("{text}");
+    } else {
+        eprintln!("{comment}");
+    }
+    Ok(0)
+}
