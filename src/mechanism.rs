@@ -19,7 +19,7 @@ pub const GRAVITY_M_S2: f64 = 9.81;
 
 /// Every parameter of Table 2 plus the two the paper leaves open (θ1 and the reading of μ in the
 /// pack capacity is decided by the caller, see [`Mechanism::pack_capacity_nm`]).
-#[cfg_attr(feature = "snapshot", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(feature = "config-block", derive(serde::Serialize, serde::Deserialize))]
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Mechanism {
     /// m_s, mass of the output shaft (kg).

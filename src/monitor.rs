@@ -56,7 +56,7 @@
 
 mod checks;
 mod config;
-#[cfg(feature = "snapshot")]
+#[cfg(feature = "config-block")]
 pub mod config_block;
 mod convert;
 mod estimate;

@@ -6,7 +6,7 @@
 //! converts the same numbers once, in its constructor, into fixed-point scale factors.
 
 /// Motor, reducer and sensor parameters.
-#[cfg_attr(feature = "snapshot", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(feature = "config-block", derive(serde::Serialize, serde::Deserialize))]
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct SensorConfig {
     /// Motor torque constant (N·m/A).

@@ -139,7 +139,7 @@ mod target {
         RESET_EVERY.store(args.reset_every, Ordering::Relaxed);
         session::self_check();
         let (stream, replay) = session::open(&args);
-        let monitor = session::monitor(&replay, &args, "an evaluation board");
+        let monitor = session::monitor(&replay, &args, "an evaluation board", None);
         if args.bench {
             session::run_bench(replay, stream, monitor, peripherals.SYST)
         } else {

@@ -7,7 +7,7 @@ use crate::sensors::{SensorConfig, DEFAULT_SENSORS};
 
 /// Observer gains of the current-estimator form (see [`crate::monitor`]): the angle, speed and
 /// acceleration corrections per unit of angle innovation.
-#[cfg_attr(feature = "snapshot", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(feature = "config-block", derive(serde::Serialize, serde::Deserialize))]
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct ObserverGains {
     /// l₁, angle correction (dimensionless).
@@ -59,9 +59,9 @@ impl ObserverGains {
 pub const IMPACT_DECAY_RAD_S2: f64 = 10.0;
 
 /// Limits and time constants (SI). Defaults in [`Thresholds::DEFAULT`], with their reasons in
-/// docs/monitor-design.md. With `snapshot`, serde reads and writes them by field name (the
+/// docs/monitor-design.md. With `config-block`, serde reads and writes them by field name (the
 /// host's configuration file).
-#[cfg_attr(feature = "snapshot", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(feature = "config-block", derive(serde::Serialize, serde::Deserialize))]
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Thresholds {
     /// Operating envelope of the load (N·m); an implied load beyond it while driving means the
@@ -221,7 +221,7 @@ impl Default for Thresholds {
 
 /// How the pack is pressed while the drive turns the output against the load: a plant fact the
 /// paper leaves open (docs/model.md, "The plant family"), set by commissioning.
-#[cfg_attr(feature = "snapshot", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(feature = "config-block", derive(serde::Serialize, serde::Deserialize))]
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum DrivingPack {
     /// The drive's pull on the ramps unloads the spring: `F = F_s/(1 + a·k)` (the physical
@@ -231,9 +231,9 @@ pub enum DrivingPack {
     SpringOnly,
 }
 
-/// Everything the monitor is configured with; separate from its state. With `snapshot`, serde
-/// writes it as the firmware's configuration block (`config_block`).
-#[cfg_attr(feature = "snapshot", derive(serde::Serialize, serde::Deserialize))]
+/// Everything the monitor is configured with; separate from its state. With `config-block`,
+/// serde writes it as the firmware's configuration block (`config_block`).
+#[cfg_attr(feature = "config-block", derive(serde::Serialize, serde::Deserialize))]
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Config {
     /// The mechanism (Table 2 by default).

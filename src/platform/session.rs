@@ -152,14 +152,14 @@ impl Stream {
     }
 }
 
-/// The unit's configuration: its block (`config=FILE`, what a flash page holds on a real part)
-/// or, without one, the uncommissioned defaults. A refused block stops the run.
-fn configuration(args: &Args) -> (Config, &'static str) {
+/// The unit's configuration: the block `config=FILE` names, else the board's `resident` one
+/// (its flash sector), else the uncommissioned defaults. A refused `config=FILE` stops the run.
+fn configuration(args: &Args, resident: Option<(Config, &'static str)>) -> (Config, &'static str) {
     let Some(path) = core::ffi::CStr::from_bytes_until_nul(&args.config_path)
         .ok()
         .filter(|p| !p.is_empty())
     else {
-        return (Config::default(), "uncommissioned");
+        return resident.unwrap_or((Config::default(), "uncommissioned"));
     };
     let Ok(mut file) = File::open(path) else {
         fail("cannot open the configuration block")
@@ -178,9 +178,15 @@ fn configuration(args: &Args) -> (Config, &'static str) {
     }
 }
 
-/// The monitor with the unit's configuration, announced with the run's mode.
-pub fn monitor(replay: &Streamed<'static>, args: &Args, board: &str) -> Monitor {
-    let (config, source) = configuration(args);
+/// The monitor with the unit's configuration (see `configuration`), announced with the run's
+/// mode.
+pub fn monitor(
+    replay: &Streamed<'static>,
+    args: &Args,
+    board: &str,
+    resident: Option<(Config, &'static str)>,
+) -> Monitor {
+    let (config, source) = configuration(args, resident);
     let Ok(monitor) = Monitor::new(config) else {
         fail("the monitor configuration was rejected")
     };

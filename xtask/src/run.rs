@@ -24,6 +24,8 @@ pub const STRESS_RESET_EVERY: u32 = 50;
 
 /// Real-time boot: 2^4 ns = 16 ns per instruction.
 pub const REALTIME_SHIFT: u32 = 4;
+/// The STM32F405's configuration sector (`boards/stm32f405/memory.x`, `CONFIG`).
+const CONFIG_SECTOR: u32 = 0x080E_0000;
 /// The monitor's tick rate (Hz).
 const TICK_HZ: f64 = 10_000.0;
 /// Bench boot: 2^10 ns per instruction, 12.8 (M0/M3) or 25.6 (M4F) SysTick ticks each.
@@ -195,13 +197,23 @@ pub fn replay_report_with(
     let trace_arg = format!("trace={}", replay_path.display());
     let mut rt_args = vec!["realtime".to_string(), trace_arg.clone()];
     let mut bench_args = vec!["bench".to_string(), trace_arg];
+    // The block: in the part's configuration sector (QEMU's loader writes it into the flash
+    // image, as commissioning would), or named over semihosting on the evaluation boards.
+    let mut block_flags = Vec::new();
     if let Some(c) = &config {
         let mut block = [0_u8; CONFIG_BLOCK_BYTES];
         let n = config_block::encode(c, &mut block).map_err(|e| format!("config block: {e:?}"))?;
         let path = dir.join(format!("{stem}.nbc1"));
         std::fs::write(&path, &block[..n]).map_err(|e| e.to_string())?;
-        rt_args.push(format!("config={}", path.display()));
-        bench_args.push(format!("config={}", path.display()));
+        if core == Core::Stm32f405 {
+            block_flags = vec![
+                "-device".to_string(),
+                format!("loader,file={},addr={CONFIG_SECTOR:#x}", path.display()),
+            ];
+        } else {
+            rt_args.push(format!("config={}", path.display()));
+            bench_args.push(format!("config={}", path.display()));
+        }
     }
     // The evaluation boards' image writes its trip log's region here at the end.
     let region = dir.join(format!("{stem}-{}.flash", core.name()));
@@ -218,13 +230,14 @@ pub fn replay_report_with(
     }
     // The board's GPIO is read back from QEMU's log of its (unmodelled) registers.
     let gpio_log = dir.join(format!("{stem}-{}-gpio.log", core.name()));
-    let rt_extra = if core == Core::Stm32f405 {
+    let mut rt_extra = if core == Core::Stm32f405 {
         crate::board_pin::qemu_flags(&gpio_log)
     } else {
         Vec::new()
     };
+    rt_extra.extend(block_flags.iter().cloned());
     let realtime = boot(core, &elf, REALTIME_SHIFT, rt_args, echo, &rt_extra)?;
-    let bench = boot(core, &elf, BENCH_SHIFT, bench_args, false, &[])?;
+    let bench = boot(core, &elf, BENCH_SHIFT, bench_args, false, &block_flags)?;
 
     let summary = line_with(&realtime.lines, "summary")?;
     let bench_line = line_with(&bench.lines, "bench")?;

@@ -146,7 +146,7 @@ pub fn main(a: &TestArgs) -> Result<i32, String> {
             section("one time base: a flag's time from run equals monitor's (m3)");
             run_and_monitor_agree_on_time()?;
             section("a commissioned unit: its configuration block, bit-exact (m3)");
-            commissioned_block_is_bit_exact()?;
+            commissioned_block_is_bit_exact(Core::M3)?;
         }
         let fw_digest = u32::from_str_radix(
             report["fx_selfcheck_digest"]
@@ -299,8 +299,9 @@ fn stress_stays_within_its_deadline() -> Result<(), String> {
 /// The paper reading's reverse_load commissioned from itself (a spring-only pack, another
 /// form than the defaults'), its configuration handed to the firmware as a block: the firmware
 /// must say it runs on the block and stay bit-exact with the host on the same configuration,
-/// whose estimates differ from the uncommissioned ones.
-fn commissioned_block_is_bit_exact() -> Result<(), String> {
+/// whose estimates differ from the uncommissioned ones (on the STM32F405 the block sits in its
+/// configuration sector, as commissioning writes it).
+pub fn commissioned_block_is_bit_exact(core: Core) -> Result<(), String> {
     let dir = crate::shell::workspace_root().join("target").join("replay");
     std::fs::create_dir_all(&dir).map_err(|e| e.to_string())?;
     let scene = dir.join("paper_reverse_load.toml");
@@ -312,8 +313,7 @@ fn commissioned_block_is_bit_exact() -> Result<(), String> {
     let scene = scene.to_string_lossy().into_owned();
     let trace = crate::replay::twin_trace(&scene)?;
     let c = host_tests::commission::commission(&[(&trace, 20.3)])?;
-    let (report, ok) =
-        run::replay_report_with(&scene, Core::M3, None, None, false, Some(c.config))?;
+    let (report, ok) = run::replay_report_with(&scene, core, None, None, false, Some(c.config))?;
     let uncommissioned = crate::replay::host_run(
         &crate::replay::nbr1(&trace)?,
         &[],

@@ -23,6 +23,8 @@ use {defmt_rtt as _, panic_probe as _};
 #[cfg(target_os = "none")]
 mod clock;
 #[cfg(target_os = "none")]
+mod config_sector;
+#[cfg(target_os = "none")]
 mod io;
 
 /// The application: RTIC's generated code needs `unsafe` for its resource cells.
@@ -80,7 +82,8 @@ mod app {
             let args = session::args();
             session::self_check();
             let (stream, replay) = session::open(&args);
-            let monitor = session::monitor(&replay, &args, "STM32F405");
+            let resident = crate::config_sector::configuration();
+            let monitor = session::monitor(&replay, &args, "STM32F405", Some(resident));
             if args.bench {
                 session::run_bench(replay, stream, monitor, cx.core.SYST)
             }

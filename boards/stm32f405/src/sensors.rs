@@ -2,10 +2,11 @@
 //! on ADC1 (PA3, continuous conversion: the tick reads the latest result), the motor encoder
 //! on TIM4's encoder mode (PB6/PB7, 16-bit as the monitor expects), the output encoder on
 //! TIM5's (PA0/PA1; an SPI absolute encoder would implement `EncoderCounter` the same way),
-//! the drive command on PB0.
+//! the drive command on PB0. The monitor's configuration is the block in the last flash sector
+//! (`config_sector`).
 
 use noback::board::{BoardSensors, CurrentAdc, EncoderCounter};
-use noback::monitor::{Config, Monitor};
+use noback::monitor::Monitor;
 use stm32f4xx_hal::adc::config::{AdcConfig, Continuous, SampleTime, Sequence};
 use stm32f4xx_hal::adc::Adc;
 use stm32f4xx_hal::gpio::{Input, PA0, PA1, PA3, PB0, PB6, PB7};
@@ -50,7 +51,7 @@ pub struct Wiring {
     pub drive: PB0,
 }
 
-/// Configures the sensors and the monitor (default configuration).
+/// Configures the sensors and the monitor (the unit's configuration block).
 pub fn setup(rcc: &mut Rcc, w: Wiring) -> (crate::io::Stream, Sensors, Monitor) {
     let (adc1, pa3) = w.adc;
     let config = AdcConfig::default().continuous(Continuous::Continuous);
@@ -63,8 +64,8 @@ pub fn setup(rcc: &mut Rcc, w: Wiring) -> (crate::io::Stream, Sensors, Monitor) 
     let (tim5, pa0, pa1) = w.output;
     let output = Encoder(Qei::new(tim5, (pa0, pa1), rcc));
     let drive = w.drive.into_input();
-    let Ok(monitor) = Monitor::new(Config::default()) else {
-        crate::clock::halt("the default monitor configuration was rejected")
+    let Ok(monitor) = Monitor::new(crate::config_sector::configuration().0) else {
+        crate::clock::halt("the monitor configuration was rejected")
     };
     let sensors = BoardSensors::new(PhaseCurrent(adc), motor, output, drive);
     (crate::io::Stream, sensors, monitor)
