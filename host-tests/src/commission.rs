@@ -17,6 +17,7 @@
 //! test, issue 17); `capacity_mu` stays at Table 2's μ_s.
 
 use crate::accuracy::run_monitor;
+use noback::fx::{adc_centered, counter_delta};
 use noback::mechanism::Mechanism;
 use noback::monitor::{Config, DrivingPack, Thresholds};
 use noback_twin::trace::Trace;
@@ -31,7 +32,7 @@ pub const MIN_DRIVE_S: f64 = 0.2;
 pub const MIN_HOLD_S: f64 = 0.1;
 /// Output travel allowed over the final hold (rad): a few encoder counts of rattle.
 pub const HOLD_CREEP_RAD: f64 = 0.005;
-/// Slowest steady drive (rad/s at the output) and largest speed ripple over the window (share).
+/// Slowest steady drive (rad/s at the output).
 pub const MIN_SPEED_RAD_S: f64 = 1.0;
 /// Largest speed ripple over the window, as a share of the mean speed.
 pub const MAX_RIPPLE: f64 = 0.05;
@@ -85,27 +86,30 @@ fn mean(x: impl Iterator<Item = f64>) -> f64 {
 /// The output angle (rad) of every row, unwrapped from the encoder's counts.
 fn output_angles(trace: &Trace, c: &Config) -> Vec<f64> {
     let bits = c.sensors.output_encoder_bits;
-    let modulus = 1_i64 << bits;
-    let rad = core::f64::consts::TAU / modulus as f64;
-    let mut turns = 0_i64;
-    let mut prev = None;
+    let rad = c.sensors.output_rad_per_count();
+    let mut prev = trace.rows.first().map_or(0, |r| r.output_count);
+    let mut n = 0_i64;
     trace
         .rows
         .iter()
         .map(|r| {
-            let n = i64::from(r.output_count);
-            if let Some(p) = prev {
-                let d: i64 = n - p;
-                if d > modulus / 2 {
-                    turns -= modulus;
-                } else if d < -modulus / 2 {
-                    turns += modulus;
-                }
-            }
-            prev = Some(n);
-            (n + turns) as f64 * rad
+            n += i64::from(counter_delta(prev, r.output_count, bits));
+            prev = r.output_count;
+            n as f64 * rad
         })
         .collect()
+}
+
+/// Mean current reading over the last [`MIN_HOLD_S`] of a run (A), drive off there.
+fn hold_current_a(trace: &Trace, c: &Config) -> f64 {
+    let s = &c.sensors;
+    let hold = (MIN_HOLD_S / (1.0 / trace.sample_rate_hz)) as usize;
+    let tail = &trace.rows[trace.rows.len().saturating_sub(hold + 1)..];
+    mean(
+        tail.iter().map(|r| {
+            f64::from(adc_centered(r.current_code, s.current_adc_bits)) * s.amps_per_count()
+        }),
+    )
 }
 
 /// One run's figures, the monitor set with `base`; refuses a run that cannot give them.
@@ -182,13 +186,6 @@ fn measure(trace: &Trace, load_nm: f64, base: Config) -> Result<RunFigures, Stri
             .iter()
             .map(|e| e.drive_torque_nm.to_num::<f64>()),
     );
-    let s = &base.sensors;
-    let mid = f64::from(1_u32 << (s.current_adc_bits - 1));
-    let hold_current = mean(
-        rows[end - hold..]
-            .iter()
-            .map(|r| (f64::from(r.current_code) - mid) * s.amps_per_count()),
-    );
     // Braking: from the cut to the output's turning point (the first sample at the far end of
     // its travel).
     let dir = speed.signum();
@@ -203,7 +200,8 @@ fn measure(trace: &Trace, load_nm: f64, base: Config) -> Result<RunFigures, Stri
         return Err("the output did not move after the cut".into());
     }
     let m: &Mechanism = &base.mechanism;
-    // The pack's torque: the deceleration's, less the load's share (it opposes an opening).
+    // The pack's torque from the deceleration: J·|α| − M opening (the load helps stop the
+    // output), J·|α| + M closing.
     let opposed = m.output_inertia_kg_m2 * (speed.abs() / braking_time) + dir * load_nm;
     let capacity = m.pack_capacity_nm(m.quasi_static_pressing_force_n(load_nm), base.capacity_mu);
     Ok(RunFigures {
@@ -212,7 +210,7 @@ fn measure(trace: &Trace, load_nm: f64, base: Config) -> Result<RunFigures, Stri
         drive_speed_rad_s: speed,
         drive_torque_nm: drive_torque,
         closing: speed > 0.0,
-        hold_current_a: hold_current,
+        hold_current_a: hold_current_a(trace, &base),
         braking_time_s: braking_time,
         braking_nm: opposed,
         braking_share: opposed / capacity,
@@ -232,10 +230,12 @@ pub fn commission(runs: &[(&Trace, f64)]) -> Result<Commissioning, String> {
         }
     };
     let first = runs.first().ok_or("no acceptance run")?;
-    // The offset first (drive off in the hold), so the drive torques are read without it.
+    // The offset first (drive off in the hold, once the run checked out), so the drive torques
+    // are read without it.
     let mut base = Config::default();
-    let offset = measure(first.0, first.1, base).map_err(|e| name(0) + &e)?;
-    base.current_offset_a = offset.hold_current_a;
+    base.current_offset_a = measure(first.0, first.1, base)
+        .map_err(|e| name(0) + &e)?
+        .hold_current_a;
     let figures = runs
         .iter()
         .enumerate()
@@ -318,17 +318,18 @@ pub fn commission(runs: &[(&Trace, f64)]) -> Result<Commissioning, String> {
         }
         (false, _) => drag / spring,
     };
-    let mut config = configured(base, a, heaviest.braking_share, relieved);
+    let braking_share = heaviest.braking_share;
+    let mut config = configured(base, a, braking_share, relieved);
     // The monitor's torque per amp, so that its drive torque reads true.
     config.sensors.motor_torque_constant_nm_a /= gain;
     config.commissioned = true;
     noback::monitor::Monitor::new(config).map_err(|e| format!("the identified settings: {e}"))?;
     Ok(Commissioning {
-        runs: figures.clone(),
+        runs: figures,
         gain,
         current_offset_a: config.current_offset_a,
         drive_drag_nm: drag,
-        braking_share: heaviest.braking_share,
+        braking_share,
         config,
     })
 }

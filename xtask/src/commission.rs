@@ -2,7 +2,7 @@
 //! settings from its recorded acceptance runs (`host_tests::commission`), written as the
 //! monitor's configuration file (`host_tests::config_file`).
 
-use crate::replay::twin_trace;
+use crate::replay::trace_of;
 use noback_twin::args::bad_input;
 use noback_twin::trace::Trace;
 use serde_json::json;
@@ -28,18 +28,6 @@ pub struct CommissionArgs {
     pub json: bool,
 }
 
-/// Reads one acceptance run: its trace and, for a scene, its own load.
-fn acceptance_run(target: &str) -> Result<(Trace, Option<f64>), String> {
-    let name = noback_twin::args::short(target);
-    if target.ends_with(".csv") {
-        return Trace::read(std::path::Path::new(target))
-            .map(|t| (t, None))
-            .map_err(|e| format!("{name}: {e}"));
-    }
-    let scene = noback_twin::cli::load_scene(target, None)?;
-    Ok((twin_trace(target)?, Some(scene.load_torque_nm)))
-}
-
 /// Entry.
 pub fn main(a: &CommissionArgs) -> Result<i32, String> {
     if !a.load_nm.is_empty() && a.load_nm.len() != a.targets.len() {
@@ -54,8 +42,8 @@ pub fn main(a: &CommissionArgs) -> Result<i32, String> {
     }
     let mut runs = Vec::new();
     for (i, target) in a.targets.iter().enumerate() {
-        let (trace, scene_load) = match acceptance_run(target) {
-            Ok(r) => r,
+        let (trace, scene_load) = match trace_of(target) {
+            Ok((trace, scene)) => (trace, scene.map(|s| s.load_torque_nm)),
             Err(e) => return Ok(bad_input("commission", &e)),
         };
         let Some(load) = a.load_nm.get(i).copied().or(scene_load) else {

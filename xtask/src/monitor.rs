@@ -3,14 +3,13 @@
 //! plot with the twin's raw and compared signals beside the monitor's estimate.
 //! The comparison itself lives in `host_tests::accuracy` (this file only runs and reports).
 
-use crate::replay::twin_trace;
+use crate::replay::trace_of;
 use crate::shell::workspace_root;
 use host_tests::accuracy::{
     compare, detection_latency_s, false_alarms, manifest_time, run_monitor, COMPARE_WINDOW_S,
 };
 use noback::monitor::Config;
 use noback_twin::svg::{render, Panel, Series};
-use noback_twin::trace::Trace;
 
 use noback_twin::args::bad_input;
 #[cfg(test)]
@@ -47,26 +46,11 @@ pub fn config_from_file(path: &std::path::Path) -> Result<Config, String> {
 /// Entry.
 pub fn main(a: &MonitorArgs) -> Result<i32, String> {
     let (target, json_out, out) = (a.target.clone(), a.json, a.out.clone());
-    // A trace file (the twin's CSV format) is replayed as it is; anything else is a scene.
-    let (faults, trace) = if target.ends_with(".csv") {
-        match Trace::read(std::path::Path::new(&target)) {
-            Ok(trace) => (Vec::new(), trace),
-            Err(e) => {
-                return Ok(bad_input(
-                    "monitor",
-                    &format!("{}: {e}", noback_twin::args::short(&target)),
-                ))
-            }
-        }
-    } else {
-        match noback_twin::cli::load_scene(&target, None) {
-            // The twin failing on a scene that passed the schema is still the scene's fault.
-            Ok(scene) => match twin_trace(&target) {
-                Ok(trace) => (scene.faults.clone(), trace),
-                Err(e) => return Ok(bad_input("monitor", &e)),
-            },
-            Err(e) => return Ok(bad_input("monitor", &e)),
-        }
+    // A trace file (the twin's CSV format) is replayed as it is; anything else is a scene (the
+    // twin failing on a scene that passed the schema is still the scene's fault).
+    let (faults, trace) = match trace_of(&target) {
+        Ok((trace, scene)) => (scene.map(|s| s.faults).unwrap_or_default(), trace),
+        Err(e) => return Ok(bad_input("monitor", &e)),
     };
     let config = match &a.config {
         None => Config::default(),

@@ -3,6 +3,18 @@
 //! reference the firmware's digest must equal bit for bit.
 
 pub use host_tests::accuracy::twin_trace;
+
+/// A recorded trace (`.csv`, the twin's format) as it is, else a scene (built-in or file) run
+/// through the twin, with the scene; the error names the input (`monitor`, `commission`).
+pub fn trace_of(target: &str) -> Result<(Trace, Option<noback_twin::scene::Scene>), String> {
+    if target.ends_with(".csv") {
+        return Trace::read(std::path::Path::new(target))
+            .map(|t| (t, None))
+            .map_err(|e| format!("{}: {e}", noback_twin::args::short(target)));
+    }
+    let scene = noback_twin::cli::load_scene(target, None)?;
+    Ok((host_tests::accuracy::scene_trace(&scene)?, Some(scene)))
+}
 use noback::app::{Ticker, Totals};
 use noback::monitor::{Config, Estimate, Inputs, Monitor};
 use noback::replay::{encode_header, encode_record, Replay};
