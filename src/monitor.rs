@@ -108,7 +108,7 @@ pub fn mul_q16(a: Q16, b: Q16) -> Q16 {
 
 /// The monitor's state: one value per stage.
 #[cfg_attr(
-    feature = "snapshot",
+    feature = "config-block",
     derive(serde::Serialize, serde::Deserialize, Hash)
 )]
 #[derive(Clone, Debug)]
@@ -135,7 +135,7 @@ struct State {
 
 /// The monitor: settings apart from state. One [`Monitor::step`] per tick.
 #[cfg_attr(
-    feature = "snapshot",
+    feature = "config-block",
     derive(serde::Serialize, serde::Deserialize, Hash)
 )]
 #[derive(Clone, Debug)]
@@ -161,8 +161,13 @@ impl Monitor {
     /// );
     /// ```
     pub fn new(config: Config) -> Result<Monitor, ConfigError> {
+        Ok(Monitor::with_settings(Settings::new(&config)?))
+    }
+
+    /// A monitor at power-on on settings already converted (a configuration block's).
+    fn with_settings(settings: Settings) -> Monitor {
         let mut monitor = Monitor {
-            settings: Settings::new(&config)?,
+            settings,
             state: State {
                 tick: 0,
                 sense: Sense::new(),
@@ -186,7 +191,7 @@ impl Monitor {
             job_due: false,
         };
         monitor.state.refresh_load(&monitor.settings);
-        Ok(monitor)
+        monitor
     }
 
     /// The model this monitor runs in `scene` (the cheapest per scene,
@@ -333,7 +338,7 @@ impl Monitor {
 
 /// A tick's slow-lane work: its slot and what sensing and the observer handed on.
 #[cfg_attr(
-    feature = "snapshot",
+    feature = "config-block",
     derive(serde::Serialize, serde::Deserialize, Hash)
 )]
 #[derive(Clone, Copy, Debug)]
@@ -345,7 +350,7 @@ struct Job {
 
 /// What the slow lane hands the next tick.
 #[cfg_attr(
-    feature = "snapshot",
+    feature = "config-block",
     derive(serde::Serialize, serde::Deserialize, Hash)
 )]
 #[derive(Clone, Copy, Debug)]

@@ -56,7 +56,7 @@ impl Torque for f32 {
 
 /// The output's motion relative to the pack.
 #[cfg_attr(
-    feature = "snapshot",
+    feature = "config-block",
     derive(serde::Serialize, serde::Deserialize, Hash)
 )]
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]

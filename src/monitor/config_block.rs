@@ -1,21 +1,23 @@
-//! The configuration block: a unit's commissioned [`Config`] as bytes, kept apart from the code
-//! (a parameter data item: one firmware image for every unit, each with its own block).
+//! The configuration block: a unit's settings as bytes, converted from its commissioned
+//! [`Config`] on the ground and kept apart from the code (a parameter data item: one firmware
+//! image for every unit, each with its own block). The flight image carries no unit conversion.
 //!
 //! | bytes | what |
 //! |---|---|
-//! | 4 | magic `NBC1` (a later layout changes it) |
-//! | n | the `Config`, postcard |
-//! | 4 | CRC-32/ISCSI of the `Config`'s bytes, little-endian (postcard's `use-crc` flavour) |
+//! | 4 | magic `NBC2` (a later layout of the settings changes it) |
+//! | n | the monitor's settings (`Settings::new` of the `Config`), postcard |
+//! | 4 | CRC-32/ISCSI of the settings' bytes, little-endian (postcard's `use-crc` flavour) |
 //!
-//! A block that is short, of another layout, corrupt or rejected by [`Monitor::new`] is refused
-//! with its reason; the firmware then does not start the monitor on it.
+//! [`encode`] refuses a `Config` that [`Monitor::new`] rejects; [`decode`] refuses a block that
+//! is short, of another layout or corrupt, with its reason.
 
+use super::settings::Settings;
 use super::{Config, ConfigError, Monitor};
 use crc::{Crc, CRC_32_ISCSI};
 
 /// The block's first bytes.
-pub const CONFIG_BLOCK_MAGIC: [u8; 4] = *b"NBC1";
-/// Room the firmware keeps for a block (a `Config` takes about 560 bytes).
+pub const CONFIG_BLOCK_MAGIC: [u8; 4] = *b"NBC2";
+/// Room the firmware keeps for a block (the default settings take 246 bytes).
 pub const CONFIG_BLOCK_BYTES: usize = 1024;
 
 const CRC: Crc<u32> = Crc::<u32>::new(&CRC_32_ISCSI);
@@ -29,68 +31,88 @@ pub enum ConfigBlockError {
     Size,
     /// The checksum or the encoding does not match: a torn or corrupt block.
     Corrupt,
-    /// A whole block whose configuration `Monitor::new` rejects.
+    /// A configuration `Monitor::new` rejects (writing).
     Rejected(ConfigError),
 }
 
-/// Writes `c`'s block into `buf`; returns its length.
+/// Converts `c` and writes its block into `buf`; returns its length.
 pub fn encode(c: &Config, buf: &mut [u8]) -> Result<usize, ConfigBlockError> {
+    let settings = Settings::new(c).map_err(ConfigBlockError::Rejected)?;
     let (head, body) = buf.split_at_mut_checked(4).ok_or(ConfigBlockError::Size)?;
     head.copy_from_slice(&CONFIG_BLOCK_MAGIC);
-    let n = postcard::to_slice_crc32(c, body, CRC.digest())
+    let n = postcard::to_slice_crc32(&settings, body, CRC.digest())
         .map_err(|_| ConfigBlockError::Size)?
         .len();
     Ok(4 + n)
 }
 
-/// Reads a block (trailing bytes after it are ignored) and checks that the monitor accepts it.
-pub fn decode(bytes: &[u8]) -> Result<Config, ConfigBlockError> {
+/// The monitor at power-on on a block's settings (trailing bytes after it are ignored).
+pub fn decode(bytes: &[u8]) -> Result<Monitor, ConfigBlockError> {
     let (head, body) = bytes.split_at_checked(4).ok_or(ConfigBlockError::Size)?;
     if head != CONFIG_BLOCK_MAGIC {
         return Err(ConfigBlockError::Magic);
     }
-    let c: Config = postcard::take_from_bytes_crc32(body, CRC.digest())
-        .map(|(c, _)| c)
+    let settings: Settings = postcard::take_from_bytes_crc32(body, CRC.digest())
+        .map(|(s, _)| s)
         .map_err(|e| match e {
             postcard::Error::DeserializeUnexpectedEnd => ConfigBlockError::Size,
             _ => ConfigBlockError::Corrupt,
         })?;
-    Monitor::new(c).map_err(ConfigBlockError::Rejected)?;
-    Ok(c)
+    Ok(Monitor::with_settings(settings))
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::monitor::Inputs;
 
     #[test]
-    fn a_block_reads_back_and_a_changed_bit_is_refused() {
+    fn a_block_gives_the_monitor_its_config_builds_and_a_changed_bit_is_refused() {
         let mut c = Config::physical_reading();
         c.sliding_mu = 0.21;
         let mut buf = [0_u8; CONFIG_BLOCK_BYTES];
         let n = encode(&c, &mut buf).unwrap();
         assert!(n < CONFIG_BLOCK_BYTES);
-        assert_eq!(decode(&buf[..n]), Ok(c));
+        let mut from_block = decode(&buf[..n]).unwrap();
+        let mut built = Monitor::new(c).unwrap();
+        assert_eq!(from_block.settings, built.settings);
+        for i in 0..500_u32 {
+            let inputs = Inputs::new(2048 + (i % 7) as u16, i * 3, i * 40, i > 100);
+            assert_eq!(from_block.step(&inputs), built.step(&inputs), "tick {i}");
+        }
         for at in [0, 4, n / 2, n - 1] {
             let mut bad = buf;
             bad[at] ^= 0x10;
             assert!(decode(&bad[..n]).is_err(), "bit flipped at {at}");
         }
-        assert_eq!(decode(&buf[..n - 2]), Err(ConfigBlockError::Size));
+        assert!(matches!(decode(&buf[..n - 2]), Err(ConfigBlockError::Size)));
         assert!(encode(&c, &mut buf[..40]).is_err());
     }
 
     #[test]
-    fn a_whole_block_the_monitor_rejects_is_refused() {
+    fn a_config_the_monitor_rejects_gives_no_block() {
         let c = Config {
             sliding_mu: -1.0,
             ..Config::default()
         };
         let mut buf = [0_u8; CONFIG_BLOCK_BYTES];
-        let n = encode(&c, &mut buf).unwrap();
         assert!(matches!(
-            decode(&buf[..n]),
+            encode(&c, &mut buf),
             Err(ConfigBlockError::Rejected(_))
         ));
+    }
+
+    /// The default settings' block, its length and checksum: a change here is a change of the
+    /// settings' layout or of a default; a layout change must also change the magic.
+    #[test]
+    fn the_default_block_is_the_one_recorded() {
+        let mut buf = [0_u8; CONFIG_BLOCK_BYTES];
+        let n = encode(&Config::default(), &mut buf).unwrap();
+        let crc = u32::from_le_bytes(buf[n - 4..n].try_into().unwrap());
+        assert_eq!(
+            (n, crc),
+            (246, 0xBBF1_4520),
+            "length and CRC of the default block"
+        );
     }
 }

@@ -28,7 +28,7 @@ use fixed::types::U40F24;
 
 /// The estimate's constants.
 #[cfg_attr(
-    feature = "snapshot",
+    feature = "config-block",
     derive(serde::Serialize, serde::Deserialize, Hash)
 )]
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -48,7 +48,7 @@ impl EstimateSettings {
 
 /// The pack's state at the last classification.
 #[cfg_attr(
-    feature = "snapshot",
+    feature = "config-block",
     derive(serde::Serialize, serde::Deserialize, Hash)
 )]
 #[derive(Clone, Copy, Debug)]
@@ -155,7 +155,7 @@ pub(crate) fn pack(k: &PackSettings, c: &Classified, i: &PackInputs) -> PackEsti
 /// Friction energy: slip power `|T·ω|` integrated in the slow lane over the ticks since its
 /// last sample (a heat estimate; saturating, monotone).
 #[cfg_attr(
-    feature = "snapshot",
+    feature = "config-block",
     derive(serde::Serialize, serde::Deserialize, Hash)
 )]
 #[derive(Clone, Copy, Debug)]

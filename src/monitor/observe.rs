@@ -17,7 +17,7 @@ use crate::fx::{counter_delta, Q16};
 
 /// The observer stage's constants.
 #[cfg_attr(
-    feature = "snapshot",
+    feature = "config-block",
     derive(serde::Serialize, serde::Deserialize, Hash)
 )]
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -113,7 +113,7 @@ impl ObserveSettings {
 
 /// What the observer stage hands on.
 #[cfg_attr(
-    feature = "snapshot",
+    feature = "config-block",
     derive(serde::Serialize, serde::Deserialize, Hash)
 )]
 #[derive(Clone, Copy, Debug)]
@@ -153,7 +153,7 @@ impl Observed {
 /// The power-on seeding: after [`POWER_ON_SEED_TICKS`] on-time, plausible ticks the observer
 /// starts from the output's measured speed with its torque balanced, instead of at rest.
 #[cfg_attr(
-    feature = "snapshot",
+    feature = "config-block",
     derive(serde::Serialize, serde::Deserialize, Hash)
 )]
 #[derive(Clone, Copy, Debug, Default)]
@@ -166,7 +166,7 @@ struct PowerOnSeed {
 
 /// The observer stage's state.
 #[cfg_attr(
-    feature = "snapshot",
+    feature = "config-block",
     derive(serde::Serialize, serde::Deserialize, Hash)
 )]
 #[derive(Clone, Copy, Debug)]

@@ -16,7 +16,7 @@ use crate::fx::Q16;
 use crate::table1::Motion;
 
 /// Exact (f64) ratios of the pack that other stages' constants derive from.
-#[cfg_attr(feature = "snapshot", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(feature = "config-block", derive(serde::Serialize, serde::Deserialize))]
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub(crate) struct PackRatios {
     /// `a·k = μ_d·c·tanθ/r`, the sliding self-locking ratio (1.42 at Table 2).
@@ -26,7 +26,7 @@ pub(crate) struct PackRatios {
 }
 
 /// The ratios' bit patterns (f64 has no `Hash`): a settings digest tells them apart exactly.
-#[cfg(feature = "snapshot")]
+#[cfg(feature = "config-block")]
 impl core::hash::Hash for PackRatios {
     fn hash<H: core::hash::Hasher>(&self, h: &mut H) {
         self.a_k.to_bits().hash(h);
@@ -36,7 +36,7 @@ impl core::hash::Hash for PackRatios {
 
 /// The pack's constants, converted once.
 #[cfg_attr(
-    feature = "snapshot",
+    feature = "config-block",
     derive(serde::Serialize, serde::Deserialize, Hash)
 )]
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -160,7 +160,7 @@ pub(crate) fn table1(stuck: bool, dir: Dir, demand: Q16, capacity: Q16) -> Q16 {
 
 /// A direction of motion or load: −1, 0 (within a dead band) or +1.
 #[cfg_attr(
-    feature = "snapshot",
+    feature = "config-block",
     derive(serde::Serialize, serde::Deserialize, Hash)
 )]
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]

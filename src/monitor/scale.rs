@@ -40,7 +40,7 @@ pub enum ScaleError {
 /// assert!(Scale::<30>::from_f64(4.0).is_err()); // 4·2^30 does not fit 31 bits
 /// ```
 #[cfg_attr(
-    feature = "snapshot",
+    feature = "config-block",
     derive(serde::Serialize, serde::Deserialize, Hash)
 )]
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]

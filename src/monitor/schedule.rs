@@ -17,7 +17,7 @@
 
 /// A lane: periodic work every `ticks` ticks (a power of two, so the slot is a mask).
 #[cfg_attr(
-    feature = "snapshot",
+    feature = "config-block",
     derive(serde::Serialize, serde::Deserialize, Hash)
 )]
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -47,7 +47,7 @@ pub const WINDOW: Lane = Lane { ticks: 16 };
 
 /// What slow-lane work a tick carries.
 #[cfg_attr(
-    feature = "snapshot",
+    feature = "config-block",
     derive(serde::Serialize, serde::Deserialize, Hash)
 )]
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]

@@ -24,7 +24,7 @@ const POSITION_HISTORY: usize = 64;
 
 /// The sensors' constants.
 #[cfg_attr(
-    feature = "snapshot",
+    feature = "config-block",
     derive(serde::Serialize, serde::Deserialize, Hash)
 )]
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -156,7 +156,7 @@ impl SenseSettings {
 
 /// What sensing hands on for one call.
 #[cfg_attr(
-    feature = "snapshot",
+    feature = "config-block",
     derive(serde::Serialize, serde::Deserialize, Hash)
 )]
 #[derive(Clone, Copy, Debug)]
@@ -202,7 +202,7 @@ impl Sensed {
 
 /// The sensors' memory.
 #[cfg_attr(
-    feature = "snapshot",
+    feature = "config-block",
     derive(serde::Serialize, serde::Deserialize, Hash)
 )]
 #[derive(Clone, Debug)]
@@ -217,7 +217,7 @@ pub(crate) struct Sense {
     input_speed: Q16,
     /// The motor counter at the last input-speed sample.
     speed_motor: u32,
-    #[cfg_attr(feature = "snapshot", serde(with = "serde_big_array::BigArray"))]
+    #[cfg_attr(feature = "config-block", serde(with = "serde_big_array::BigArray"))]
     positions: [i16; POSITION_HISTORY],
     position_head: usize,
     /// Consecutive on-time plausible ticks with the drive off in the history.

@@ -13,7 +13,7 @@ use super::sense::SenseSettings;
 
 /// Every stage's settings.
 #[cfg_attr(
-    feature = "snapshot",
+    feature = "config-block",
     derive(serde::Serialize, serde::Deserialize, Hash)
 )]
 #[derive(Clone, Copy, Debug, PartialEq)]

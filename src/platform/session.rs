@@ -152,14 +152,21 @@ impl Stream {
     }
 }
 
-/// The unit's configuration: the block `config=FILE` names, else the board's `resident` one
-/// (its flash sector), else the uncommissioned defaults. A refused `config=FILE` stops the run.
-fn configuration(args: &Args, resident: Option<(Config, &'static str)>) -> (Config, &'static str) {
+/// The monitor on the unit's configuration: the block `config=FILE` names, else the board's
+/// `resident` one (its flash sector), else the uncommissioned defaults. A refused `config=FILE`
+/// stops the run.
+fn configured(args: &Args, resident: Option<(Monitor, &'static str)>) -> (Monitor, &'static str) {
     let Some(path) = core::ffi::CStr::from_bytes_until_nul(&args.config_path)
         .ok()
         .filter(|p| !p.is_empty())
     else {
-        return resident.unwrap_or((Config::default(), "uncommissioned"));
+        if let Some(resident) = resident {
+            return resident;
+        }
+        let Ok(monitor) = Monitor::new(Config::default()) else {
+            fail("the default configuration was rejected")
+        };
+        return (monitor, "uncommissioned");
     };
     let Ok(mut file) = File::open(path) else {
         fail("cannot open the configuration block")
@@ -173,23 +180,20 @@ fn configuration(args: &Args, resident: Option<(Config, &'static str)>) -> (Conf
         }
     }
     match config_block::decode(block.get(..n).unwrap_or(&[])) {
-        Ok(c) => (c, "from its block"),
-        Err(_) => fail("the configuration block is refused (layout, checksum or a rejected value)"),
+        Ok(monitor) => (monitor, "from its block"),
+        Err(_) => fail("the configuration block is refused (layout or checksum)"),
     }
 }
 
-/// The monitor with the unit's configuration (see `configuration`), announced with the run's
+/// The monitor with the unit's configuration (see `configured`), announced with the run's
 /// mode.
 pub fn monitor(
     replay: &Streamed<'static>,
     args: &Args,
     board: &str,
-    resident: Option<(Config, &'static str)>,
+    resident: Option<(Monitor, &'static str)>,
 ) -> Monitor {
-    let (config, source) = configuration(args, resident);
-    let Ok(monitor) = Monitor::new(config) else {
-        fail("the monitor configuration was rejected")
-    };
+    let (monitor, source) = configured(args, resident);
     defmt::info!(
         "noback firmware {=str} on {=str}: {=u32} samples at {=u32} Hz, mode {=str}, configuration {=str}",
         env!("CARGO_PKG_VERSION"),

@@ -203,7 +203,7 @@ pub fn replay_report_with(
     if let Some(c) = &config {
         let mut block = [0_u8; CONFIG_BLOCK_BYTES];
         let n = config_block::encode(c, &mut block).map_err(|e| format!("config block: {e:?}"))?;
-        let path = dir.join(format!("{stem}.nbc1"));
+        let path = dir.join(format!("{stem}.nbc"));
         std::fs::write(&path, &block[..n]).map_err(|e| e.to_string())?;
         if core == Core::Stm32f405 {
             block_flags = vec![

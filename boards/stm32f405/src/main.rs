@@ -82,7 +82,7 @@ mod app {
             let args = session::args();
             session::self_check();
             let (stream, replay) = session::open(&args);
-            let resident = crate::config_sector::configuration();
+            let resident = crate::config_sector::monitor();
             let monitor = session::monitor(&replay, &args, "STM32F405", Some(resident));
             if args.bench {
                 session::run_bench(replay, stream, monitor, cx.core.SYST)

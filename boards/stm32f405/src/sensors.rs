@@ -64,9 +64,8 @@ pub fn setup(rcc: &mut Rcc, w: Wiring) -> (crate::io::Stream, Sensors, Monitor) 
     let (tim5, pa0, pa1) = w.output;
     let output = Encoder(Qei::new(tim5, (pa0, pa1), rcc));
     let drive = w.drive.into_input();
-    let Ok(monitor) = Monitor::new(crate::config_sector::configuration().0) else {
-        crate::clock::halt("the monitor configuration was rejected")
-    };
+    let (monitor, source) = crate::config_sector::monitor();
+    defmt::info!("noback firmware on STM32F405: configuration {=str}", source);
     let sensors = BoardSensors::new(PhaseCurrent(adc), motor, output, drive);
     (crate::io::Stream, sensors, monitor)
 }

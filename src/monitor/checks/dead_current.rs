@@ -43,7 +43,7 @@ use crate::monitor::schedule::WINDOW;
 
 /// The dead-reading check's constants.
 #[cfg_attr(
-    feature = "snapshot",
+    feature = "config-block",
     derive(serde::Serialize, serde::Deserialize, Hash)
 )]
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -95,7 +95,7 @@ pub(crate) const BLOCK_WINDOWS: u8 = 8;
 
 /// State of the dead-reading check: the block being summed, and when the pack last held.
 #[cfg_attr(
-    feature = "snapshot",
+    feature = "config-block",
     derive(serde::Serialize, serde::Deserialize, Hash)
 )]
 #[derive(Clone, Copy, Debug)]

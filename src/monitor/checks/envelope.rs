@@ -20,7 +20,7 @@ use crate::monitor::sense::times;
 
 /// The envelope's constants.
 #[cfg_attr(
-    feature = "snapshot",
+    feature = "config-block",
     derive(serde::Serialize, serde::Deserialize, Hash)
 )]
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -106,7 +106,7 @@ fn model_ticks(model_hz: f64, tick_hz: f64) -> Result<u32, ConfigError> {
 
 /// One braking event's envelope (drive cut to lock).
 #[cfg_attr(
-    feature = "snapshot",
+    feature = "config-block",
     derive(serde::Serialize, serde::Deserialize, Hash)
 )]
 #[derive(Clone, Copy, Debug, Default)]
@@ -129,7 +129,7 @@ pub(crate) struct Envelope {
 
 /// What one envelope call reads.
 #[cfg_attr(
-    feature = "snapshot",
+    feature = "config-block",
     derive(serde::Serialize, serde::Deserialize, Hash)
 )]
 #[derive(Clone, Copy, Debug)]

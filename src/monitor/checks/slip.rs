@@ -27,7 +27,7 @@ use crate::monitor::convert::counts;
 /// One shaft's monotone excursion: where the current run in one direction started and how far
 /// it has gone.
 #[cfg_attr(
-    feature = "snapshot",
+    feature = "config-block",
     derive(serde::Serialize, serde::Deserialize, Hash)
 )]
 #[derive(Clone, Copy, Debug, Default)]
@@ -70,7 +70,7 @@ impl Excursion {
 
 /// State of the common-slip check.
 #[cfg_attr(
-    feature = "snapshot",
+    feature = "config-block",
     derive(serde::Serialize, serde::Deserialize, Hash)
 )]
 #[derive(Clone, Copy, Debug, Default)]
@@ -86,7 +86,7 @@ pub(crate) struct SlipCheck {
 
 /// The check's limits, in counts (from the configuration).
 #[cfg_attr(
-    feature = "snapshot",
+    feature = "config-block",
     derive(serde::Serialize, serde::Deserialize, Hash)
 )]
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
