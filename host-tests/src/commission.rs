@@ -1,4 +1,4 @@
-//! Commissioning (docs/monitor-design.md, "Configuration file and commissioning"): the plant
+//! Commissioning (docs/commissioning.md): the plant
 //! facts the uncommissioned monitor cannot know, identified from the unit's acceptance runs —
 //! each: the drive turns the door against (opening) or with (closing) a known load at a steady
 //! speed, is cut, and the brake holds the door; two opening runs at different loads also give

@@ -1,4 +1,4 @@
-//! The monitor's configuration as a TOML file (docs/monitor-design.md, "Configuration file"):
+//! The monitor's configuration as a TOML file (docs/commissioning.md):
 //! a base settings set, then any threshold (by its `Thresholds` field name, through serde) or
 //! model constant. Unknown keys, wrong types and values `Config` rejects are errors naming
 //! the key.

@@ -1,4 +1,4 @@
-//! Commissioning (docs/monitor-design.md, "Commissioning") tested on runs it did not see: set
+//! Commissioning (docs/commissioning.md) tested on runs it did not see: set
 //! from one acceptance run of each reading, evaluated on other loads, speeds, current noise and
 //! noise seeds, and on closing runs.
 

@@ -26,7 +26,7 @@ pub struct MonitorArgs {
     /// Print the report as one JSON object.
     #[arg(long)]
     pub json: bool,
-    /// The monitor's configuration file (docs/monitor-design.md, "Configuration file");
+    /// The monitor's configuration file (docs/commissioning.md);
     /// default: uncommissioned.
     #[arg(long, value_name = "FILE")]
     pub config: Option<PathBuf>,

@@ -47,7 +47,7 @@ pub struct RunArgs {
     /// Print the summary as one JSON object.
     #[arg(long)]
     pub json: bool,
-    /// The monitor's configuration file (docs/monitor-design.md, "Configuration file"), handed
+    /// The monitor's configuration file (docs/commissioning.md), handed
     /// to the firmware as its configuration block; default: uncommissioned.
     #[arg(long, value_name = "FILE")]
     pub config: Option<std::path::PathBuf>,
