@@ -18,6 +18,7 @@ mod monitor;
 mod monitor_mc;
 mod opt_level;
 mod pages;
+mod profile;
 mod qemu;
 mod reliability;
 mod replay;
@@ -81,6 +82,8 @@ enum Cmd {
     Log(trip_log::LogArgs),
     /// The trip log's power-loss test: a cut at every flash step, records lost and corrupt.
     PowerFail(trip_log::PowerFailArgs),
+    /// Where the monitor's instructions go per step, by stage (QEMU, one instruction a block).
+    Profile(profile::ProfileArgs),
     /// Add missing rustup targets and install qemu-system-arm if missing.
     Bootstrap,
 }
@@ -168,6 +171,7 @@ fn dispatch(args: &[String]) -> i32 {
         Cmd::Bench(_) => bench::main(rest),
         Cmd::Log(a) => trip_log::main(&a),
         Cmd::PowerFail(a) => trip_log::power_fail(&a),
+        Cmd::Profile(a) => profile::main(&a),
         Cmd::Bootstrap => bootstrap::ensure_all().map(|()| 0),
     };
     match result {

@@ -56,6 +56,23 @@ pub struct RunArgs {
     pub overrun_at: Option<u32>,
 }
 
+/// Writes `trace` as the replay file the firmware streams (target/replay/STEM.nbr1); returns
+/// the directory, the scene's stem, the file and its bytes.
+pub fn write_replay(
+    scene: &str,
+    trace: &noback_twin::trace::Trace,
+) -> Result<(std::path::PathBuf, String, std::path::PathBuf, Vec<u8>), String> {
+    let bytes = nbr1(trace)?;
+    let dir = workspace_root().join("target").join("replay");
+    std::fs::create_dir_all(&dir).map_err(|e| e.to_string())?;
+    let stem = std::path::Path::new(scene)
+        .file_stem()
+        .map_or("scene".into(), |s| s.to_string_lossy().into_owned());
+    let replay_path = dir.join(format!("{stem}.nbr1"));
+    std::fs::write(&replay_path, &bytes).map_err(|e| e.to_string())?;
+    Ok((dir, stem, replay_path, bytes))
+}
+
 /// `key=value` fields of a decoded log line.
 pub fn fields(line: &str) -> BTreeMap<&str, &str> {
     line.split_whitespace()
@@ -176,14 +193,7 @@ pub fn replay_report_with(
         }
         twin_trace(scene)?
     };
-    let bytes = nbr1(&trace)?;
-    let dir = workspace_root().join("target").join("replay");
-    std::fs::create_dir_all(&dir).map_err(|e| e.to_string())?;
-    let stem = std::path::Path::new(&scene)
-        .file_stem()
-        .map_or("scene".into(), |s| s.to_string_lossy().into_owned());
-    let replay_path = dir.join(format!("{stem}.nbr1"));
-    std::fs::write(&replay_path, &bytes).map_err(|e| e.to_string())?;
+    let (dir, stem, replay_path, bytes) = write_replay(scene, &trace)?;
     if echo {
         println!(
             "replay: {} samples, {} bytes -> {}",

@@ -68,6 +68,7 @@ const COMMANDS: &[&str] = &[
     "bench",
     "log",
     "power-fail",
+    "profile",
     "bootstrap",
 ];
 
@@ -98,6 +99,8 @@ fn bad_values_are_refused_naming_them() {
         (&["test", "--core", "m9"], "m9"),
         (&["qemu", "x.elf", "--core", "m9"], "m9"),
         (&["run", "--overrun-at", "-1"], "-1"),
+        (&["profile", "--core", "m9"], "m9"),
+        (&["profile", "--scene", "no_such_scene"], "no_such_scene"),
         (&["run", "--overrun-at", "abc"], "abc"),
         (&["qemu", "x.elf", "--timeout", "NaN"], "NaN"),
         (&["qemu", "x.elf", "--timeout", "inf"], "inf"),
