@@ -42,6 +42,8 @@ pub struct Ticker<S, P> {
     digest: Fnv1a,
     last: Option<Estimate>,
     last_inputs: Option<Inputs>,
+    /// The tick at which the crew requests the functional test (`u32::MAX`: never).
+    test_at: u32,
 }
 
 /// Counters a run reports at its end.
@@ -78,7 +80,13 @@ impl<S: SampleSource, P: OutputPin> Ticker<S, P> {
             digest: Fnv1a::new(),
             last: None,
             last_inputs: None,
+            test_at: u32::MAX,
         }
+    }
+
+    /// Requests the monitor's functional test before tick `tick` (counted from 0) steps.
+    pub fn request_functional_test_at(&mut self, tick: u32) {
+        self.test_at = tick;
     }
 
     /// One tick. `ticks_elapsed` is 1 when on time, `n > 1` after a missed deadline. Returns
@@ -98,6 +106,9 @@ impl<S: SampleSource, P: OutputPin> Ticker<S, P> {
         let mut inputs = self.source.sample()?;
         inputs.ticks_elapsed = n;
         self.last_inputs = Some(inputs);
+        if self.ticks == self.test_at {
+            self.monitor.request_functional_test();
+        }
         let estimate = self.monitor.tick(&inputs);
         self.ticks = self.ticks.saturating_add(1);
         self.digest.push(estimate_checksum(&estimate));

@@ -60,6 +60,7 @@ mod config;
 pub mod config_block;
 mod convert;
 mod estimate;
+pub mod functional_test;
 mod io;
 mod load;
 mod observe;
@@ -85,6 +86,7 @@ pub use snapshot::SnapshotError;
 use crate::fx::Q16;
 use checks::{BrakingTick, CheckInputs, Checks};
 use estimate::{Energy, PackInputs};
+use functional_test::{FunctionalTest, TestReport};
 use load::Load;
 use observe::{Observe, Observed};
 use pack::Dir;
@@ -131,6 +133,8 @@ struct State {
     fault_latched: bool,
     /// The last slow-lane run's results, until the next tick applies them.
     slow: SlowResult,
+    /// The commanded functional test, from the crew's request.
+    test: Option<FunctionalTest>,
 }
 
 /// The monitor: settings apart from state. One [`Monitor::step`] per tick.
@@ -182,6 +186,7 @@ impl Monitor {
                 flags: Flags::default(),
                 fault_latched: false,
                 slow: SlowResult::NONE,
+                test: None,
             },
             job: Job {
                 slot: Slot::Free,
@@ -209,6 +214,18 @@ impl Monitor {
     /// The latched flags.
     pub fn flags(&self) -> Flags {
         self.state.flags
+    }
+
+    /// Starts the commanded functional test with this tick's slow-lane work (the ground crew's
+    /// request; the drive runs the ramp of `Config::functional_test`). A test already run is
+    /// started afresh.
+    pub fn request_functional_test(&mut self) {
+        self.state.test = Some(FunctionalTest::new());
+    }
+
+    /// The functional test's report, once requested.
+    pub fn functional_test(&self) -> Option<TestReport> {
+        self.state.test.as_ref().map(FunctionalTest::report)
     }
 
     /// Clears the latched flags (a condition still present raises its flag again).
@@ -333,6 +350,9 @@ impl Monitor {
             gave_way,
             reading_switch,
         };
+        if let Some(test) = st.test.as_mut() {
+            test.step(&k.functional_test, x, o.drive_torque, st.flags);
+        }
     }
 }
 

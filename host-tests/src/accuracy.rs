@@ -13,6 +13,7 @@
 //! - lock time: first sample after the drive is cut at which the brake state is locked and
 //!   stays locked for [`LOCK_CONFIRM_S`].
 
+use noback::monitor::functional_test::{TestConfig, TestReport};
 use noback::monitor::{BrakeState, Config, Estimate, Flags, Inputs, Monitor};
 use noback_twin::fault::{Fault, FaultKind};
 use noback_twin::trace::Trace;
@@ -65,6 +66,33 @@ pub fn run_monitor(trace: &Trace, config: Config) -> Result<Vec<Estimate>, Strin
             ))
         })
         .collect())
+}
+
+/// The functional test's report after running the monitor over `trace` with `test` as its
+/// procedure and the crew's request at `start_s`.
+pub fn run_functional_test(
+    trace: &Trace,
+    mut config: Config,
+    test: &TestConfig,
+    start_s: f64,
+) -> Result<TestReport, String> {
+    config.functional_test = *test;
+    let mut monitor = Monitor::new(config).map_err(|e| format!("monitor config: {e:?}"))?;
+    let start = (start_s * trace.sample_rate_hz).round() as usize;
+    for (i, r) in trace.rows.iter().enumerate() {
+        if i == start {
+            monitor.request_functional_test();
+        }
+        monitor.step(&Inputs::new(
+            r.current_code,
+            r.motor_count,
+            r.output_count,
+            r.drive_on,
+        ));
+    }
+    monitor
+        .functional_test()
+        .ok_or_else(|| format!("the test was requested at {start_s} s, after the trace's end"))
 }
 
 /// Centred moving average over `window` samples (shrinking at the ends).

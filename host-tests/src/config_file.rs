@@ -12,8 +12,13 @@
 //! motor_torque_constant_nm_a = 0.066
 //! [monitor.thresholds]
 //! opposed_braking_share = 1.0
+//! [monitor.functional_test]      # the commanded test's procedure (TestConfig's fields)
+//! load_nm = 20.3
+//! expected_breakaway_nm = 11.0   # the unit's acceptance test (absent: the design's)
+//! min_margin = 0.95
 //! ```
 
+use noback::monitor::functional_test::TestConfig;
 use noback::monitor::{Config, DrivingPack, Monitor, Thresholds};
 use toml::{Table, Value};
 
@@ -57,6 +62,35 @@ fn thresholds(base: Thresholds, given: Table) -> Result<Thresholds, String> {
         .map_err(|e: toml::de::Error| e.to_string())
 }
 
+/// The functional test's keys and fields, in `TestConfig`'s order.
+fn test_fields(t: &mut TestConfig) -> [(&'static str, &mut f64); 7] {
+    [
+        ("load_nm", &mut t.load_nm),
+        ("torque_rate_nm_s", &mut t.torque_rate_nm_s),
+        ("max_torque_nm", &mut t.max_torque_nm),
+        ("breakaway_rad", &mut t.breakaway_rad),
+        ("min_margin", &mut t.min_margin),
+        ("max_margin", &mut t.max_margin),
+        ("torque_filter_hz", &mut t.torque_filter_hz),
+    ]
+}
+
+/// `[monitor.functional_test]` over the defaults.
+fn functional_test(mut given: Table) -> Result<TestConfig, String> {
+    let mut t = TestConfig::DEFAULT;
+    for (key, field) in test_fields(&mut t) {
+        if let Some(v) = given.remove(key) {
+            *field = number(&v, &format!("monitor.functional_test.{key}"))?;
+        }
+    }
+    if let Some(v) = given.remove("expected_breakaway_nm") {
+        t.expected_breakaway_nm =
+            Some(number(&v, "monitor.functional_test.expected_breakaway_nm")?);
+    }
+    no_more(&given, "monitor.functional_test.")?;
+    Ok(t)
+}
+
 /// Parses a configuration file's text; the result is validated by `Monitor::new`.
 pub fn parse(text: &str) -> Result<Config, String> {
     let mut root: Table = text
@@ -77,6 +111,9 @@ pub fn parse(text: &str) -> Result<Config, String> {
     };
     if let Some(t) = m.remove("thresholds") {
         c.thresholds = thresholds(c.thresholds, table(t, "monitor.thresholds")?)?;
+    }
+    if let Some(t) = m.remove("functional_test") {
+        c.functional_test = functional_test(table(t, "monitor.functional_test")?)?;
     }
     for (key, field) in [
         ("capacity_mu", &mut c.capacity_mu),
@@ -149,6 +186,23 @@ pub fn write(c: &Config, comment: &str) -> Result<String, String> {
             }
         }
     }
+    let (mut base, mut now) = (TestConfig::DEFAULT, c.functional_test);
+    let mut test = String::new();
+    for ((key, b), (_, v)) in test_fields(&mut base)
+        .into_iter()
+        .zip(test_fields(&mut now))
+    {
+        if *b != *v {
+            test.push_str(&format!("{key} = {v:?}\n"));
+        }
+    }
+    if let Some(b) = c.functional_test.expected_breakaway_nm {
+        test.push_str(&format!("expected_breakaway_nm = {b:?}\n"));
+    }
+    if !test.is_empty() {
+        out.push_str("[monitor.functional_test]\n");
+        out.push_str(&test);
+    }
     match parse(&out) {
         Ok(back) if back == *c => Ok(out),
         Ok(_) => Err("the configuration sets a field the file does not carry".into()),
@@ -180,6 +234,7 @@ mod tests {
         c.sliding_mu = 0.2345678901;
         c.driving_pack = DrivingPack::SpringOnly;
         c.thresholds.creep_limit_rad = 0.125;
+        c.functional_test = TestConfig::commissioned(18.5, 10.25);
         let text = write(&c, "test").unwrap();
         assert_eq!(parse(&text), Ok(c), "{text}");
         let mut other = c;
@@ -205,6 +260,14 @@ mod tests {
                 "opposed_braking_share",
             ),
             ("[other]\n", "[monitor]"),
+            (
+                "[monitor.functional_test]\nload = 1\n",
+                "monitor.functional_test.load",
+            ),
+            (
+                "[monitor.functional_test]\nmin_margin = 2\n",
+                "functional_test.min_margin",
+            ),
         ] {
             let e = parse(text).unwrap_err();
             assert!(e.contains(key), "{text:?}: {e}");

@@ -8,6 +8,7 @@
 pub mod accuracy;
 pub mod commission;
 pub mod config_file;
+pub mod dormant;
 pub mod family;
 pub mod fuzz;
 pub mod mc;

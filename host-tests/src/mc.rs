@@ -15,6 +15,7 @@
 //! alarm. Runs are spread over the machine's cores.
 
 use crate::accuracy::{compare, detection_latency_s, manifest_time, run_monitor, scene_trace};
+use crate::dormant::{functional_test_after, Verdict};
 use crate::family::Family;
 use noback::mechanism::Mechanism;
 use noback::monitor::Config;
@@ -68,6 +69,9 @@ pub struct Outcome {
     /// A nominal draw whose plant does not move its output while driven ([`not_driven`]):
     /// counted apart from the false alarms, whatever the monitor raised.
     pub not_driven: bool,
+    /// The functional test after the run ([`crate::dormant`]): every dormant fault run and a
+    /// share of the nominal runs ([`Campaign::test_every`]), physical form only.
+    pub test: Option<Verdict>,
 }
 
 impl Outcome {
@@ -352,6 +356,9 @@ pub struct Campaign {
     pub config: Config,
     /// How long the twin runs before the monitor is powered on (s).
     pub pre_roll_s: f64,
+    /// The functional test also runs after one nominal run in this many (by the run's noise
+    /// seed; 0: none) — and after every fault run whose fault stayed dormant (unless 0).
+    pub test_every: u64,
 }
 
 impl Campaign {
@@ -360,6 +367,7 @@ impl Campaign {
         Campaign {
             config: family.config(),
             pre_roll_s: PRE_ROLL_S,
+            test_every: TEST_EVERY,
         }
     }
 }
@@ -371,7 +379,10 @@ impl Default for Campaign {
     }
 }
 
-/// Runs one draw through the twin and the monitor.
+/// The share of nominal runs the functional test follows by default (one in this many).
+pub const TEST_EVERY: u64 = 10;
+
+/// Runs one draw through the twin and the monitor, then the functional test if it is due.
 pub fn evaluate(d: &Draw, campaign: &Campaign) -> Outcome {
     let fault = d.scene.faults.first().copied();
     let fail = |e: String| Outcome {
@@ -382,6 +393,7 @@ pub fn evaluate(d: &Draw, campaign: &Campaign) -> Outcome {
         false_flags: 0,
         error: Some(e),
         not_driven: false,
+        test: None,
     };
     let trace = match draw_trace_after(d, campaign.pre_roll_s) {
         Ok(trace) => trace,
@@ -395,14 +407,31 @@ pub fn evaluate(d: &Draw, campaign: &Campaign) -> Outcome {
     };
     let acc = compare(&trace, &estimates);
     let onset = fault.map_or(f64::INFINITY, |f| f.at_s);
+    let manifested = fault.is_some_and(|f| manifest_time(&f, &trace).is_some());
+    let not_driven = fault.is_none() && not_driven(&trace);
+    let every = campaign.test_every;
+    let tested = every > 0
+        && match fault {
+            Some(_) => !manifested,
+            None => !not_driven && d.scene.noise.seed.is_multiple_of(every),
+        };
+    let test = if tested {
+        match functional_test_after(d, campaign.config) {
+            Ok(v) => v,
+            Err(e) => return fail(e),
+        }
+    } else {
+        None
+    };
     Outcome {
         fault: fault.map(|f| f.kind),
         latency_s: fault.and_then(|f| detection_latency_s(&f, &trace, &acc)),
-        manifested: fault.is_some_and(|f| manifest_time(&f, &trace).is_some()),
+        manifested,
         context: fault.map(|f| Context::of(f.at_s, &trace, d.scene.kind, &campaign.config)),
         false_flags: acc.flags.iter().filter(|f| f.t_s < onset).count(),
         error: None,
-        not_driven: fault.is_none() && not_driven(&trace),
+        not_driven,
+        test,
     }
 }
 

@@ -2,6 +2,7 @@
 //! builder checks it and converts it into fixed point once (`settings.rs`).
 
 use super::convert::exp_neg;
+use super::functional_test::TestConfig;
 use crate::mechanism::{Mechanism, TABLE2};
 use crate::sensors::{SensorConfig, DEFAULT_SENSORS};
 
@@ -272,6 +273,8 @@ pub struct Config {
     /// Whether the model constants were set for this plant. Uncommissioned (false) no estimate
     /// is trusted: on the plant family its errors reach 30–100 % (docs/monitor.md); flags run.
     pub commissioned: bool,
+    /// The commanded functional test's procedure and pass floor.
+    pub functional_test: TestConfig,
 }
 
 /// Default rate of the fault-braking model (Hz): the cheapest-per-scene table's choice for
@@ -300,6 +303,7 @@ impl Config {
             max_catchup_ticks: 8,
             braking_model_hz: DEFAULT_BRAKING_MODEL_HZ,
             commissioned: false,
+            functional_test: TestConfig::DEFAULT,
         }
     }
 }

@@ -5,6 +5,7 @@ use super::checks::CheckSettings;
 use super::config::{Config, ConfigError};
 use super::convert::{positive, require};
 use super::estimate::EstimateSettings;
+use super::functional_test::TestSettings;
 use super::load::LoadSettings;
 use super::observe::ObserveSettings;
 use super::pack::PackSettings;
@@ -25,6 +26,7 @@ pub(crate) struct Settings {
     pub load: LoadSettings,
     pub estimate: EstimateSettings,
     pub checks: CheckSettings,
+    pub functional_test: TestSettings,
     /// No estimate is trusted unless the monitor was set for its plant.
     pub commissioned: bool,
 }
@@ -45,6 +47,7 @@ impl Settings {
             load: LoadSettings::new(c)?,
             estimate: EstimateSettings::new(c)?,
             checks: CheckSettings::new(c, &pack, &ratios)?,
+            functional_test: TestSettings::new(c)?,
             commissioned: c.commissioned,
         })
     }

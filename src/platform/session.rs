@@ -1,12 +1,13 @@
 //! What every firmware image under QEMU shares, whatever its board: the semihosting
 //! arguments (`trace=FILE`, `bench`, `overrun-at=N`, `reset-every=N`, `trip-log=FILE`,
-//! `config=FILE`), the trace it streams from the host, the boot self-check, the bench loop that
+//! `config=FILE`, `functional-test-at=N`), the trace it streams from the host, the boot self-check, the bench loop that
 //! counts instructions, and the log lines the xtask decodes (`cargo xtask run` parses them).
 
 use crate::app::{estimate_checksum, Ticker};
 use crate::board::SampleSource;
 use crate::digest::Fnv1a;
 use crate::event_log::{tick_time, Decimal, Event};
+use crate::monitor::functional_test::TestResult;
 use crate::monitor::{config_block, BrakeState, Config, Monitor, Scene};
 use crate::platform::{self, meter::Meter, stack};
 use crate::replay::{self, Feeder, StreamRing, Streamed, FEED_CHUNK, HEADER_BYTES, RECORD_BYTES};
@@ -26,6 +27,8 @@ pub struct Args {
     pub overrun_at: u32,
     /// Reset the flags after every this many ticks (0: never).
     pub reset_every: u32,
+    /// The tick at which the ground crew requests the functional test (`u32::MAX`: never).
+    pub functional_test_at: u32,
     path: [u8; PATH_BYTES + 1],
     trip_path: [u8; PATH_BYTES + 1],
     config_path: [u8; PATH_BYTES + 1],
@@ -46,6 +49,7 @@ pub fn args() -> Args {
         bench: false,
         overrun_at: u32::MAX,
         reset_every: 0,
+        functional_test_at: u32::MAX,
         path: [0; PATH_BYTES + 1],
         trip_path: [0; PATH_BYTES + 1],
         config_path: [0; PATH_BYTES + 1],
@@ -73,6 +77,8 @@ pub fn args() -> Args {
                 a.overrun_at = n.parse().unwrap_or(u32::MAX);
             } else if let Some(n) = arg.strip_prefix("reset-every=") {
                 a.reset_every = n.parse().unwrap_or(0);
+            } else if let Some(n) = arg.strip_prefix("functional-test-at=") {
+                a.functional_test_at = n.parse().unwrap_or(u32::MAX);
             }
         }
     }
@@ -287,6 +293,26 @@ pub fn finish<P: embedded_hal::digital::OutputPin>(
 ) -> ! {
     let t = app.totals();
     let last = app.last_estimate();
+    if let Some(r) = app.monitor().functional_test() {
+        let result = match r.result {
+            TestResult::Running => defmt::intern!("running"),
+            TestResult::Pass => defmt::intern!("pass"),
+            TestResult::Fail => defmt::intern!("fail"),
+            TestResult::Aborted => defmt::intern!("aborted"),
+        };
+        let (b, c) = (
+            Decimal::from_q16(r.breakaway_torque_nm.to_bits(), 1000),
+            Decimal::from_q16(r.capacity_nm.to_bits(), 1000),
+        );
+        let m = Decimal::from_q16(r.margin.to_bits(), 1000);
+        defmt::info!(
+            "functional-test result={=istr} breakaway_nm={=str}{=u32}.{=u32:03} capacity_nm={=str}{=u32}.{=u32:03} margin={=str}{=u32}.{=u32:03}",
+            result,
+            b.sign(), b.whole, b.frac,
+            c.sign(), c.whole, c.frac,
+            m.sign(), m.whole, m.frac
+        );
+    }
     defmt::info!(
         "summary ticks={=u32} overruns={=u32} missed={=u32} starved={=u32} log_overwritten={=u32} alarm_errors={=u32} flags={=u8:#04x} stack_bytes={=u32} isr_ticks_max={=u32} background_ticks_max={=u32} period_ticks={=u32} digest={=u32:#010x}",
         t.ticks,

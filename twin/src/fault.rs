@@ -5,7 +5,7 @@
 //! | `friction_loss` | pack μ_s and μ_d multiplied by `1 − severity` (contamination, glazing) |
 //! | `spring_broken` | wave-spring stiffness multiplied by `1 − severity` (relaxation, breakage) |
 //! | `pack_wear` | pack clearance g_p2 grows by `severity × 1 mm` (worn discs: less preload, more travel) |
-//! | `ramp_jam` | ball axial friction raised to `μ_d + severity·(1 − μ_d)` (physical); ramp force scaled by `1 − severity` (paper) |
+//! | `ramp_jam` | the output balls cannot climb their sockets: the ramp's axial force on the pack × `1 − severity` (both readings; 1 = spring alone) |
 //! | `drag` | an extra pressing force of `severity × 1000 N` (partial seizure, heat) |
 //! | `encoder_stuck` | output-encoder reading frozen from `at_s` (severity ignored) |
 //! | `encoder_jump` | output-encoder reading jumps by `severity × 2^bits / 8` counts at `at_s` |

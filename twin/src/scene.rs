@@ -20,6 +20,9 @@ pub enum SceneKind {
     Hold,
     /// Opening against the load with the drive on throughout.
     Drive,
+    /// The commanded functional test: from rest under the load, the drive creeps along the load
+    /// with a torque limit that rises until the brake breaks away ([`TestProfile`]).
+    FunctionalTest,
 }
 
 impl SceneKind {
@@ -31,6 +34,7 @@ impl SceneKind {
             "continuous_closing" => SceneKind::ContinuousClosing,
             "hold" => SceneKind::Hold,
             "drive" => SceneKind::Drive,
+            "functional_test" => SceneKind::FunctionalTest,
             _ => return None,
         })
     }
@@ -43,10 +47,11 @@ impl SceneKind {
             SceneKind::ContinuousClosing => "continuous_closing",
             SceneKind::Hold => "hold",
             SceneKind::Drive => "drive",
+            SceneKind::FunctionalTest => "functional_test",
         }
     }
 
-    /// All kinds.
+    /// The paper's five kinds (§4 and the holding and driving cases); the functional test apart.
     pub const ALL: [SceneKind; 5] = [
         SceneKind::ReverseLoad,
         SceneKind::ForwardLoad,
@@ -59,7 +64,9 @@ impl SceneKind {
     pub fn direction(self) -> f64 {
         match self {
             SceneKind::ReverseLoad | SceneKind::Drive => -1.0,
-            SceneKind::ForwardLoad | SceneKind::ContinuousClosing => 1.0,
+            SceneKind::ForwardLoad | SceneKind::ContinuousClosing | SceneKind::FunctionalTest => {
+                1.0
+            }
             SceneKind::Hold => 0.0,
         }
     }
@@ -69,6 +76,34 @@ impl SceneKind {
         !matches!(self, SceneKind::Hold)
     }
 }
+
+/// The functional test's drive (scene kind `functional_test`): after `start_s` at rest under
+/// the load, the drive creeps along the load at `creep_speed_rad_s` with its torque limit rising
+/// at `torque_rate_nm_s` up to `torque_max_nm`; once the output has turned `abort_angle_rad`
+/// from where it was at `start_s`, it stops pushing and holds the door at rest.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct TestProfile {
+    /// Rest before the ramp starts (s): the load settles on the brake.
+    pub start_s: f64,
+    /// Input-shaft creep speed along the load (rad/s).
+    pub creep_speed_rad_s: f64,
+    /// Rise rate of the drive's torque limit (N·m/s at the input shaft).
+    pub torque_rate_nm_s: f64,
+    /// Largest torque limit (N·m at the input shaft).
+    pub torque_max_nm: f64,
+    /// Output travel from rest at which the drive stops pushing (rad).
+    pub abort_angle_rad: f64,
+}
+
+/// The default test: 0.2 s at rest, 1 rad/s creep, 20 N·m/s to 40 N·m (the motor's full
+/// scale is 40.5 N·m), stopped after 0.05 rad (2.9°) of output travel.
+pub const DEFAULT_TEST: TestProfile = TestProfile {
+    start_s: 0.2,
+    creep_speed_rad_s: 1.0,
+    torque_rate_nm_s: 20.0,
+    torque_max_nm: 40.0,
+    abort_angle_rad: 0.05,
+};
 
 /// Sensor-noise settings of the trace.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -112,6 +147,8 @@ pub struct Scene {
     pub open: OpenItems,
     /// Faults.
     pub faults: Vec<Fault>,
+    /// The functional test's drive (used by `functional_test` scenes only).
+    pub test: TestProfile,
 }
 
 impl Scene {
@@ -123,13 +160,17 @@ impl Scene {
             SceneKind::ContinuousClosing => (None, 3.0),
             SceneKind::Hold => (None, 0.5),
             SceneKind::Drive => (None, 0.5),
+            SceneKind::FunctionalTest => (None, 2.7),
         };
         Scene {
             name: kind.name().to_string(),
             kind,
             reading,
             load_torque_nm: TABLE2.load_torque_nm,
-            initial_speed_rad_s: if kind == SceneKind::Hold { 0.0 } else { 13.78 },
+            initial_speed_rad_s: match kind {
+                SceneKind::Hold | SceneKind::FunctionalTest => 0.0,
+                _ => 13.78,
+            },
             release_at_s: release,
             duration_s: duration,
             tolerance: 1e-5,
@@ -143,6 +184,7 @@ impl Scene {
             },
             open: DEFAULT_OPEN,
             faults: Vec::new(),
+            test: DEFAULT_TEST,
         }
     }
 

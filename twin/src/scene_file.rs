@@ -199,7 +199,7 @@ impl RawFile {
             bad(
                 "scene.kind",
                 format!(
-                    "`{}` is not one of reverse_load, forward_load, continuous_closing, hold, drive",
+                    "`{}` is not one of reverse_load, forward_load, continuous_closing, hold, drive, functional_test",
                     short(&self.scene.kind)
                 ),
             )
@@ -213,6 +213,9 @@ impl RawFile {
                 )
             })?,
         };
+        if kind == SceneKind::FunctionalTest && reading == Reading::Paper {
+            return Err(bad("scene.reading", crate::cli::PAPER_NO_TEST.into()));
+        }
         let mut s = Scene::builtin(kind, reading);
         s.name = name.to_string();
         ranged(

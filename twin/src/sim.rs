@@ -39,10 +39,42 @@ pub fn model_config(scene: &Scene) -> ModelConfig {
         },
         drive: Drive {
             on: scene.kind.drive_at_start(),
-            speed_ref_rad_s: speed,
+            ..scene_drive(scene, 0.0, true)
         },
     }
 }
+
+/// The drive a scene commands at time `t_s` (`on` = not yet cut): the scene's speed, and for
+/// the functional test its creep speed under the torque limit's ramp.
+fn scene_drive(scene: &Scene, t_s: f64, on: bool) -> Drive {
+    if scene.kind == SceneKind::FunctionalTest {
+        let p = &scene.test;
+        if !on {
+            // Stopped at the abort angle: the drive holds the door at rest, at full torque.
+            return Drive {
+                on: true,
+                speed_ref_rad_s: 0.0,
+                torque_limit_nm: None,
+            };
+        }
+        return Drive {
+            on,
+            speed_ref_rad_s: p.creep_speed_rad_s,
+            torque_limit_nm: Some(
+                (p.torque_rate_nm_s * (t_s - p.start_s)).clamp(0.0, p.torque_max_nm),
+            ),
+        };
+    }
+    Drive {
+        on: on && scene.kind.drive_at_start() && scene.release_at_s.is_none_or(|r| t_s < r),
+        speed_ref_rad_s: scene.signed_initial_speed_rad_s(),
+        torque_limit_nm: None,
+    }
+}
+
+/// The functional test's torque ramp is stepped every millisecond, when the output's travel is
+/// also checked against the abort angle (the firmware checks it every tick).
+const TEST_SEGMENT_S: f64 = 1e-3;
 
 /// Run a scene under its reading.
 pub fn run(scene: &Scene) -> Result<Run, SolverError> {
@@ -93,6 +125,10 @@ pub fn run_model_with<M: TwinModel, I: SegmentSolver>(
     if let Some(r) = scene.release_at_s {
         breaks.push(r);
     }
+    if scene.kind == SceneKind::FunctionalTest {
+        let n = (scene.duration_s / TEST_SEGMENT_S).ceil() as usize;
+        breaks.extend((1..n).map(|i| i as f64 * TEST_SEGMENT_S));
+    }
     breaks.retain(|&b| b > 0.0 && b < scene.duration_s);
     breaks.push(scene.duration_s);
     breaks.sort_by(f64::total_cmp);
@@ -104,7 +140,8 @@ pub fn run_model_with<M: TwinModel, I: SegmentSolver>(
     samples.push(model.sample(0.0, &y));
     let mut smp = Sampler::new(dt, dt);
     let mut t = 0.0;
-    let speed = scene.signed_initial_speed_rad_s();
+    let mut rest_angle = None;
+    let mut aborted = false;
     for &b in &breaks {
         integ.integrate(
             &mut model,
@@ -116,14 +153,13 @@ pub fn run_model_with<M: TwinModel, I: SegmentSolver>(
             },
         )?;
         t = b;
-        let drive_on = scene.kind.drive_at_start() && scene.release_at_s.is_none_or(|r| t < r);
-        model.set_drive(
-            Drive {
-                on: drive_on,
-                speed_ref_rad_s: speed,
-            },
-            &mut y,
-        );
+        let angle = samples.last().map_or(0.0, |s| s.output_angle_rad);
+        if t >= scene.test.start_s {
+            let rest = *rest_angle.get_or_insert(angle);
+            aborted |= scene.kind == SceneKind::FunctionalTest
+                && (angle - rest).abs() >= scene.test.abort_angle_rad;
+        }
+        model.set_drive(scene_drive(scene, t, !aborted), &mut y);
         model.set_faults(PhysicsFaults::at(&scene.faults, t), &mut y);
     }
     Ok(Run {

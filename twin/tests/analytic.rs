@@ -21,6 +21,7 @@ fn config(speed: f64, drive_on: bool) -> ModelConfig {
         drive: Drive {
             on: drive_on,
             speed_ref_rad_s: speed,
+            torque_limit_nm: None,
         },
     }
 }

@@ -72,3 +72,56 @@ fn sensor_faults_touch_only_the_readings() {
     let early = at(0.04);
     assert_eq!(faulty.rows[early], healthy.rows[early]);
 }
+
+/// A ramp jam (the balls cannot climb): at full severity the pack is clamped by the spring
+/// alone (≈ 8.4 N·m, below the 20.3 N·m load) and the held door back-drives, in both readings;
+/// at 0.3 the load still holds (a partial jam lowers the capacity, it does not show).
+#[test]
+fn a_full_ramp_jam_lets_the_held_load_back_drive_and_a_partial_one_holds() {
+    for reading in [Reading::Paper, Reading::Physical] {
+        for (severity, runs_away) in [(1.0, true), (0.3, false)] {
+            let mut s = Scene::builtin(SceneKind::Hold, reading);
+            s.duration_s = 0.3;
+            s.faults.push(Fault {
+                kind: FaultKind::RampJam,
+                at_s: 0.1,
+                severity,
+            });
+            let r = sim::run(&s).unwrap();
+            let last = r.samples.last().unwrap();
+            assert_eq!(
+                last.output_speed_rad_s > 1.0,
+                runs_away,
+                "{reading:?} jam {severity}: speed {}",
+                last.output_speed_rad_s
+            );
+        }
+    }
+}
+
+/// The functional test's drive: at rest until the ramp starts, then it pushes along the load
+/// until the output breaks away, and from the abort angle it holds the door at rest.
+#[test]
+fn the_functional_test_pushes_until_breakaway_and_stops_at_the_abort_angle() {
+    let s = Scene::builtin(SceneKind::FunctionalTest, Reading::Physical);
+    let r = sim::run(&s).unwrap();
+    let at = |t: f64| r.samples.iter().find(|x| x.t_s >= t).unwrap();
+    let rest = at(s.test.start_s).output_angle_rad;
+    assert!((at(0.15).output_angle_rad - rest).abs() < 1e-3);
+    let peak = r
+        .samples
+        .iter()
+        .map(|x| x.drive_torque_nm)
+        .fold(0.0, f64::max);
+    assert!((5.0..20.0).contains(&peak), "breakaway push {peak} N·m");
+    let end = r.samples.last().unwrap();
+    assert!(
+        end.drive_on && end.output_speed_rad_s.abs() < 0.05,
+        "{end:?}"
+    );
+    let travel = end.output_angle_rad - rest;
+    assert!(
+        travel >= s.test.abort_angle_rad && travel < 2.0 * s.test.abort_angle_rad,
+        "travel {travel} rad"
+    );
+}

@@ -75,7 +75,7 @@ pub fn stage() -> Result<u32, String> {
         );
     }
     section("STM32F405: a commissioned unit's block in its configuration sector");
-    crate::test::commissioned_block_is_bit_exact(Core::Stm32f405)?;
+    crate::commissioned::block_is_bit_exact(Core::Stm32f405)?;
     section("STM32F405: a fault scene drives the alarm pin at the flag's tick");
     let (fault, ok) = run::replay_report(&fault_scene()?, Core::Stm32f405, None, None, false)?;
     print_line(&fault);

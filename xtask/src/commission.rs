@@ -3,7 +3,10 @@
 //! monitor's configuration file (`host_tests::config_file`).
 
 use crate::replay::trace_of;
+use host_tests::accuracy::run_functional_test;
+use noback::monitor::functional_test::{TestConfig, TestResult};
 use noback_twin::args::bad_input;
+use noback_twin::scene::SceneKind;
 use noback_twin::trace::Trace;
 use serde_json::json;
 use std::path::PathBuf;
@@ -13,7 +16,8 @@ use std::path::PathBuf;
 pub struct CommissionArgs {
     /// The acceptance runs, each a built-in scene, a TOML scene file or a recorded trace
     /// (`.csv`): the drive opens against a known load, is cut, and the brake holds; two at loads
-    /// 5 N·m or more apart also give the current's gain (docs/monitor-design.md).
+    /// 5 N·m or more apart also give the current's gain (docs/monitor-design.md). A
+    /// `functional_test` scene among them sets the functional test's expected breakaway.
     #[arg(value_name = "SCENE|FILE|TRACE.csv", required = true)]
     pub targets: Vec<String>,
     /// The load the crew applied in each run, in order (N·m); a scene's own load when not given,
@@ -41,8 +45,14 @@ pub fn main(a: &CommissionArgs) -> Result<i32, String> {
         ));
     }
     let mut runs = Vec::new();
+    // The unit's functional test at acceptance: (trace, its scene), set after the rest.
+    let mut test_run = None;
     for (i, target) in a.targets.iter().enumerate() {
         let (trace, scene_load) = match trace_of(target) {
+            Ok((trace, Some(scene))) if scene.kind == SceneKind::FunctionalTest => {
+                test_run = Some((trace, scene));
+                continue;
+            }
             Ok((trace, scene)) => (trace, scene.map(|s| s.load_torque_nm)),
             Err(e) => return Ok(bad_input("commission", &e)),
         };
@@ -58,10 +68,39 @@ pub fn main(a: &CommissionArgs) -> Result<i32, String> {
         runs.push((trace, load));
     }
     let pairs: Vec<(&Trace, f64)> = runs.iter().map(|(t, l)| (t, *l)).collect();
-    let c = match host_tests::commission::commission(&pairs) {
+    let mut c = match host_tests::commission::commission(&pairs) {
         Ok(c) => c,
         Err(e) => return Ok(bad_input("commission", &e)),
     };
+    let mut test_note = String::new();
+    if let Some((trace, scene)) = &test_run {
+        let procedure = TestConfig {
+            load_nm: scene.load_torque_nm,
+            torque_rate_nm_s: scene.test.torque_rate_nm_s,
+            max_torque_nm: scene.test.torque_max_nm,
+            ..TestConfig::DEFAULT
+        };
+        let r = run_functional_test(trace, c.config, &procedure, scene.test.start_s)?;
+        if r.result != TestResult::Pass {
+            return Ok(bad_input(
+                "commission",
+                &format!(
+                    "the acceptance functional test did not pass ({:?}): the unit is not healthy",
+                    r.result
+                ),
+            ));
+        }
+        let b = (r.breakaway_torque_nm.to_num::<f64>() * 1e3).round() / 1e3;
+        c.config.functional_test = TestConfig {
+            torque_rate_nm_s: procedure.torque_rate_nm_s,
+            max_torque_nm: procedure.max_torque_nm,
+            ..TestConfig::commissioned(procedure.load_nm, b)
+        };
+        test_note = format!(
+            ", functional test breakaway {b} N·m at {} N·m",
+            procedure.load_nm
+        );
+    }
     let loads: Vec<String> = runs.iter().map(|(_, l)| format!("{l}")).collect();
     let comment = format!(
         "cargo xtask commission {} (loads {} N·m): current offset {:.3} A, gain {:.4}, drag while driving {:.3} N·m, braking against the load {:.3} of capacity",
@@ -71,7 +110,7 @@ pub fn main(a: &CommissionArgs) -> Result<i32, String> {
         c.gain,
         c.drive_drag_nm,
         c.braking_share
-    );
+    ) + &test_note;
     let text = host_tests::config_file::write(&c.config, &comment)?;
     if let Some(path) = &a.out {
         std::fs::write(path, &text).map_err(|e| format!("{}: {e}", path.display()))?;

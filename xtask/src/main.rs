@@ -9,6 +9,7 @@ mod board_pin;
 mod board_test;
 mod bootstrap;
 mod commission;
+mod commissioned;
 mod cores;
 mod defmt_log;
 mod elf_size;

@@ -5,10 +5,13 @@
 
 use crate::replay::trace_of;
 use crate::shell::workspace_root;
+use host_tests::accuracy::run_functional_test;
 use host_tests::accuracy::{
     compare, detection_latency_s, false_alarms, manifest_time, run_monitor, COMPARE_WINDOW_S,
 };
+use noback::monitor::functional_test::TestConfig;
 use noback::monitor::Config;
+use noback_twin::scene::{Scene, SceneKind};
 use noback_twin::svg::{render, Panel, Series};
 
 use noback_twin::args::bad_input;
@@ -44,14 +47,37 @@ pub fn config_from_file(path: &std::path::Path) -> Result<Config, String> {
 }
 
 /// Entry.
+/// The functional test of a `functional_test` scene, requested when its ramp starts, with the
+/// scene's load and ramp and the expected breakaway of `config`'s design.
+fn functional_test_json(
+    trace: &noback_twin::trace::Trace,
+    config: Config,
+    scene: &Scene,
+) -> Result<serde_json::Value, String> {
+    let test = TestConfig {
+        load_nm: scene.load_torque_nm,
+        torque_rate_nm_s: scene.test.torque_rate_nm_s,
+        max_torque_nm: scene.test.torque_max_nm,
+        ..TestConfig::DEFAULT
+    };
+    let r = run_functional_test(trace, config, &test, scene.test.start_s)?;
+    Ok(json!({
+        "result": format!("{:?}", r.result).to_lowercase(),
+        "breakaway_torque_nm": r.breakaway_torque_nm.to_num::<f64>(),
+        "capacity_nm": r.capacity_nm.to_num::<f64>(),
+        "margin": r.margin.to_num::<f64>(),
+    }))
+}
+
 pub fn main(a: &MonitorArgs) -> Result<i32, String> {
     let (target, json_out, out) = (a.target.clone(), a.json, a.out.clone());
     // A trace file (the twin's CSV format) is replayed as it is; anything else is a scene (the
     // twin failing on a scene that passed the schema is still the scene's fault).
-    let (faults, trace) = match trace_of(&target) {
-        Ok((trace, scene)) => (scene.map(|s| s.faults).unwrap_or_default(), trace),
+    let (scene, trace) = match trace_of(&target) {
+        Ok((trace, scene)) => (scene, trace),
         Err(e) => return Ok(bad_input("monitor", &e)),
     };
+    let faults = scene.as_ref().map(|s| s.faults.clone()).unwrap_or_default();
     let config = match &a.config {
         None => Config::default(),
         Some(path) => match config_from_file(path) {
@@ -61,6 +87,13 @@ pub fn main(a: &MonitorArgs) -> Result<i32, String> {
     };
     let estimates = run_monitor(&trace, config)?;
     let acc = compare(&trace, &estimates);
+    let functional_test = match scene
+        .as_ref()
+        .filter(|s| s.kind == SceneKind::FunctionalTest)
+    {
+        Some(s) => Some(functional_test_json(&trace, config, s)?),
+        None => None,
+    };
 
     let detections: Vec<_> = faults
         .iter()
@@ -94,6 +127,7 @@ pub fn main(a: &MonitorArgs) -> Result<i32, String> {
         "flags": flags,
         "detection_latency_s": detections,
         "false_alarms": false_alarms(&faults, &acc),
+        "functional_test": functional_test,
         "config": a.config.as_ref().map_or("uncommissioned".into(), |p| p.display().to_string()),
     });
 

@@ -76,6 +76,10 @@ struct RunArgs {
     /// figures across the change of random stream; the page is not written.
     #[arg(long)]
     legacy_draws: bool,
+    /// The functional test follows one nominal run in K (and every run whose fault stayed
+    /// dormant); 0: no test (default: `host_tests::mc::TEST_EVERY`).
+    #[arg(long, value_name = "K")]
+    test_every: Option<u64>,
     /// Worker threads (default: the machine's cores).
     #[arg(long, value_parser = clap::value_parser!(u64).range(1..=1024))]
     threads: Option<u64>,
@@ -252,6 +256,7 @@ fn campaign_of(setup: &Setup, family: Family, seed: u64, runs: u64, fault_runs: 
         power_on_settle_s: setup.config.thresholds.power_on_settle_s,
         runs,
         fault_runs,
+        test_every: setup.test_every,
     }
 }
 
@@ -262,6 +267,9 @@ fn run_main(a: &RunArgs) -> Result<(), Fail> {
     }
     if let Some(s) = a.pre_roll {
         setup.pre_roll_s = s;
+    }
+    if let Some(k) = a.test_every {
+        setup.test_every = k;
     }
     noback::monitor::Monitor::new(setup.config)
         .map_err(|e| Fail::Input(format!("monitor configuration: {e:?}")))?;

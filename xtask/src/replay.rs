@@ -16,6 +16,7 @@ pub fn trace_of(target: &str) -> Result<(Trace, Option<noback_twin::scene::Scene
     Ok((host_tests::accuracy::scene_trace(&scene)?, Some(scene)))
 }
 use noback::app::{Ticker, Totals};
+use noback::monitor::functional_test::TestReport;
 use noback::monitor::{Config, Estimate, Inputs, Monitor};
 use noback::replay::{encode_header, encode_record, Replay};
 use noback_twin::trace::Trace;
@@ -93,6 +94,8 @@ pub struct HostRun {
     pub estimates: Vec<Estimate>,
     /// The run's counters and digest.
     pub totals: Totals,
+    /// The functional test's report, if one was requested.
+    pub functional_test: Option<TestReport>,
 }
 
 /// Steps the monitor (with `config`) over a replay on the host, applying the same missed deadlines
@@ -104,9 +107,24 @@ pub fn host_run(
     reset_every: Option<u32>,
     config: Config,
 ) -> Result<HostRun, String> {
+    host_run_tested(bytes, overruns, reset_every, config, None)
+}
+
+/// [`host_run`] with the crew's functional-test request before tick `test_at`, as the
+/// firmware's `functional-test-at=N`.
+pub fn host_run_tested(
+    bytes: &[u8],
+    overruns: &[(u32, u32)],
+    reset_every: Option<u32>,
+    config: Config,
+    test_at: Option<u32>,
+) -> Result<HostRun, String> {
     let replay = Replay::parse(bytes).map_err(|e| format!("replay: {e:?}"))?;
     let monitor = Monitor::new(config).map_err(|e| format!("monitor: {e:?}"))?;
     let mut ticker = Ticker::new(monitor, replay, HostPin::default());
+    if let Some(at) = test_at {
+        ticker.request_functional_test_at(at);
+    }
     let mut estimates = Vec::new();
     loop {
         let stepped = u32::try_from(estimates.len()).unwrap_or(u32::MAX);
@@ -128,5 +146,6 @@ pub fn host_run(
     Ok(HostRun {
         estimates,
         totals: ticker.totals(),
+        functional_test: ticker.monitor().functional_test(),
     })
 }

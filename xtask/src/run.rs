@@ -11,11 +11,13 @@
 use crate::cores::{Core, Firmware};
 use crate::qemu::BOOT_TIMEOUT;
 use crate::qemu::{self, Boot, Outcome};
-use crate::replay::{host_run, nbr1, stress_trace, twin_trace, STRESS};
+use crate::replay::{host_run, host_run_tested, nbr1, stress_trace, twin_trace, STRESS};
 use crate::shell::{self, cargo, workspace_root};
 use crate::{bootstrap, elf_size};
 use noback::monitor::config_block::{self, CONFIG_BLOCK_BYTES};
+use noback::monitor::functional_test::TestConfig;
 use noback::monitor::{Config, Flags};
+use noback_twin::scene::SceneKind;
 use serde_json::json;
 use std::collections::BTreeMap;
 
@@ -163,6 +165,21 @@ pub fn main(a: &RunArgs) -> Result<i32, String> {
     Ok(if ok { 0 } else { 1 })
 }
 
+/// The functional test a scene asks for (its procedure, and when the crew requests it), if it
+/// is a `functional_test` scene.
+fn functional_test_of(scene: &str) -> Option<(TestConfig, f64)> {
+    let s = noback_twin::cli::load_scene(scene, None).ok()?;
+    (s.kind == SceneKind::FunctionalTest).then(|| {
+        let test = TestConfig {
+            load_nm: s.load_torque_nm,
+            torque_rate_nm_s: s.test.torque_rate_nm_s,
+            max_torque_nm: s.test.torque_max_nm,
+            ..TestConfig::DEFAULT
+        };
+        (test, s.test.start_s)
+    })
+}
+
 /// Runs a scene through the firmware under QEMU and the host; returns the summary and whether
 /// the run was good (clean exits, bit-exact).
 pub fn replay_report(
@@ -192,6 +209,22 @@ pub fn replay_report_with(
             println!("twin: scene `{scene}` (physical reading)");
         }
         twin_trace(scene)?
+    };
+    // A functional-test scene: the crew requests the test when its ramp starts; without a
+    // configuration file the procedure (load, ramp) is configured as the scene sets it.
+    let (config, test_at) = match functional_test_of(scene) {
+        // A configuration file's procedure stands (a commissioned unit's expected breakaway).
+        Some((test, start_s)) => {
+            let c = config.unwrap_or(Config {
+                functional_test: test,
+                ..Config::default()
+            });
+            (
+                Some(c),
+                Some((start_s * trace.sample_rate_hz).round() as u32),
+            )
+        }
+        None => (config, None),
     };
     let (dir, stem, replay_path, bytes) = write_replay(scene, &trace)?;
     if echo {
@@ -238,6 +271,9 @@ pub fn replay_report_with(
     if let Some(n) = reset_every {
         rt_args.push(format!("reset-every={n}"));
     }
+    if let Some(n) = test_at {
+        rt_args.push(format!("functional-test-at={n}"));
+    }
     // The board's GPIO is read back from QEMU's log of its (unmodelled) registers.
     let gpio_log = dir.join(format!("{stem}-{}-gpio.log", core.name()));
     let mut rt_extra = if core == Core::Stm32f405 {
@@ -261,7 +297,7 @@ pub fn replay_report_with(
         })
         .collect::<Result<_, String>>()?;
     let config = config.unwrap_or_default();
-    let host = host_run(&bytes, &overruns, reset_every, config)?;
+    let host = host_run_tested(&bytes, &overruns, reset_every, config, test_at)?;
     let host_plain = host_run(&bytes, &[], None, config)?;
     let fw_digest = hex(&summary, "digest")?;
     let bench_digest = hex(&bench_line, "digest")?;
@@ -362,6 +398,26 @@ pub fn replay_report_with(
     } else {
         (serde_json::Value::Null, true)
     };
+    // The firmware's functional-test line, which must say what the host's test says.
+    let (functional_test, test_ok) = match &host.functional_test {
+        None => (serde_json::Value::Null, true),
+        Some(h) => {
+            let line = line_with(&realtime.lines, "functional-test")?;
+            let result: String = field(&line, "result")?;
+            let num = |k: &str| field::<f64>(&line, k);
+            let v = json!({
+                "result": result,
+                "breakaway_torque_nm": num("breakaway_nm")?,
+                "capacity_nm": num("capacity_nm")?,
+                "margin": num("margin")?,
+            });
+            let milli = |q: noback::fx::Q16| (q.to_num::<f64>() * 1e3).round() / 1e3;
+            let same = result == format!("{:?}", h.result).to_lowercase()
+                && (num("breakaway_nm")? - milli(h.breakaway_torque_nm)).abs() < 1.5e-3
+                && (num("margin")? - milli(h.margin)).abs() < 1.5e-3;
+            (v, same)
+        }
+    };
     // What the firmware announced it runs on: its block, or the uncommissioned defaults.
     let configuration = if realtime
         .lines
@@ -393,6 +449,7 @@ pub fn replay_report_with(
         "isr_deadline_pct_at_flight_clock": (1e5 * isr_insns_max * TICK_HZ / flight_hz).round() / 1e3,
         "alarm_pin": alarm_pin,
         "trip_log": trip_log,
+        "functional_test": functional_test,
         "deadline_used_pct": (1000.0 * isr_ticks_max / period_ticks).round() / 10.0,
         "deadline_used_with_background_pct": (1000.0 * background_ticks_max / period_ticks).round() / 10.0,
         "flash_bytes": flash_bytes,
@@ -406,8 +463,13 @@ pub fn replay_report_with(
         "host_digest": format!("{:#010x}", host.totals.digest),
         "key_moments": moments,
     });
-    let ok =
-        realtime.code == 0 && bench.code == 0 && bit_exact && starved == 0 && alarm_ok && trips_ok;
+    let ok = realtime.code == 0
+        && bench.code == 0
+        && bit_exact
+        && starved == 0
+        && alarm_ok
+        && trips_ok
+        && test_ok;
     Ok((report, ok))
 }
 

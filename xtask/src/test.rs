@@ -146,7 +146,9 @@ pub fn main(a: &TestArgs) -> Result<i32, String> {
             section("one time base: a flag's time from run equals monitor's (m3)");
             run_and_monitor_agree_on_time()?;
             section("a commissioned unit: its configuration block, bit-exact (m3)");
-            commissioned_block_is_bit_exact(Core::M3)?;
+            crate::commissioned::block_is_bit_exact(Core::M3)?;
+            section("the functional test on the firmware: a healthy unit passes, half a spring fails (m3)");
+            crate::commissioned::functional_test_on_firmware()?;
         }
         let fw_digest = u32::from_str_radix(
             report["fx_selfcheck_digest"]
@@ -293,45 +295,6 @@ fn stress_stays_within_its_deadline() -> Result<(), String> {
             "the load test missed its deadline, lost bit-exactness or did not load the flag path"
                 .into(),
         )
-    }
-}
-
-/// The paper reading's reverse_load commissioned from itself (a spring-only pack, another
-/// form than the defaults'), its configuration handed to the firmware as a block: the firmware
-/// must say it runs on the block and stay bit-exact with the host on the same configuration,
-/// whose estimates differ from the uncommissioned ones (on the STM32F405 the block sits in its
-/// configuration sector, as commissioning writes it).
-pub fn commissioned_block_is_bit_exact(core: Core) -> Result<(), String> {
-    let dir = crate::shell::workspace_root().join("target").join("replay");
-    std::fs::create_dir_all(&dir).map_err(|e| e.to_string())?;
-    let scene = dir.join("paper_reverse_load.toml");
-    std::fs::write(
-        &scene,
-        "[scene]\nkind = \"reverse_load\"\nreading = \"paper\"\n",
-    )
-    .map_err(|e| e.to_string())?;
-    let scene = scene.to_string_lossy().into_owned();
-    let trace = crate::replay::twin_trace(&scene)?;
-    let c = host_tests::commission::commission(&[(&trace, 20.3)])?;
-    let (report, ok) = run::replay_report_with(&scene, core, None, None, false, Some(c.config))?;
-    let uncommissioned = crate::replay::host_run(
-        &crate::replay::nbr1(&trace)?,
-        &[],
-        None,
-        noback::monitor::Config::default(),
-    )?;
-    let other = format!("{:#010x}", uncommissioned.totals.digest);
-    println!(
-        "configuration {} ({:?}), bit_exact {}, firmware digest {} (uncommissioned {other})",
-        report["configuration"],
-        c.config.driving_pack,
-        report["bit_exact"],
-        report["firmware_digest"]
-    );
-    if ok && report["configuration"] == "block" && report["firmware_digest"] != other.as_str() {
-        Ok(())
-    } else {
-        Err("the commissioned firmware did not run on its block bit-exactly".into())
     }
 }
 

@@ -19,6 +19,9 @@ pub struct Drive {
     pub on: bool,
     /// Input-shaft speed reference (rad/s).
     pub speed_ref_rad_s: f64,
+    /// Torque limit below the motor's (N·m), as the functional test ramps it; `None` = the
+    /// motor's full-scale limit.
+    pub torque_limit_nm: Option<f64>,
 }
 
 /// Everything a model needs to be built.

@@ -204,9 +204,17 @@ impl Physical {
             if let Some(slot) = contact_n.get_mut(k) {
                 *slot = f;
             }
+            // A ramp jam: the output balls cannot climb, so that share of their load is carried
+            // by the socket wall as torque alone, with no axial push towards the pack.
+            let jammed = if (1..=2).contains(&k) {
+                1.0 - self.faults.ramp_jam
+            } else {
+                1.0
+            };
             for &(i, coeff) in &c.terms {
+                let axial = if i == X_O || i == X_B { jammed } else { 1.0 };
                 if let Some(slot) = q.get_mut(i) {
-                    *slot -= c.multiplicity * f * coeff;
+                    *slot -= c.multiplicity * f * coeff * axial;
                 }
             }
         }
@@ -238,8 +246,8 @@ impl Physical {
         let axial_f = lossy * mu_d * m.connecting_shaft_mass_kg * g;
         q[X_B] -= axial_f * smooth_sign(at(y, X_B + 1), vsm);
         q[X_M] -= axial_f * smooth_sign(at(y, X_M + 1), vsm);
-        // Ball friction F_bf = μ·|F_c1 − F_c2| along the axis (cos θ component), μ raised by a jam.
-        let mu_b = mu_d + self.faults.ramp_jam * (1.0 - mu_d);
+        // Ball friction F_bf = μ·|F_c1 − F_c2| along the axis (cos θ component).
+        let mu_b = mu_d;
         let cth = m.socket_chamfer_rad.cos();
         let f1 = contact_n[0];
         let f2 = contact_n[1] + contact_n[2];
@@ -254,7 +262,11 @@ impl Physical {
         q[THETA_S] += self.cfg.load_torque_nm;
         // Drive: proportional speed servo with the motor's torque limit.
         let drive_nm = if self.drive.on && !self.conservative {
-            let lim = self.cfg.drive_torque_limit_nm();
+            let motor = self.cfg.drive_torque_limit_nm();
+            let lim = self
+                .drive
+                .torque_limit_nm
+                .map_or(motor, |l| l.clamp(0.0, motor));
             (open.drive_gain_nm_s_rad * (self.drive.speed_ref_rad_s - at(y, THETA_R + 1)))
                 .clamp(-lim, lim)
         } else {

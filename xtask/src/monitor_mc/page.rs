@@ -150,6 +150,33 @@ pub fn table(r: &Value) -> String {
             cells.join(" | ")
         );
     }
+    let ft = &r["functional_tests_nominal"];
+    let _ = writeln!(
+        s,
+        "\nDormant faults (never shown to the sensors in their scene) and the functional test \
+         after the run (physical form; docs/functional-test.md). Nominal runs \
+         tested: {}, failed {} {}, healthy units rejected at acceptance {}.\n",
+        ft["tested"],
+        ft["failed"],
+        fmt_rate(&ft["failed_rate"]),
+        ft["rejected_at_acceptance"]
+    );
+    let _ = writeln!(
+        s,
+        "| fault kind | dormant | tested | found | rate [95 % interval] |"
+    );
+    let _ = writeln!(s, "|---|---|---|---|---|");
+    for row in r["fault_kinds"].as_array().into_iter().flatten() {
+        let _ = writeln!(
+            s,
+            "| {} | {} | {} | {} | {} |",
+            row["kind"].as_str().unwrap_or(""),
+            row["dormant"],
+            row["dormant_tested"],
+            row["dormant_found"],
+            fmt_rate(&row["dormant_found_rate"]),
+        );
+    }
     let _ = writeln!(s, "\n| paper scene | pressing-force RMS (% of peak) | braking-torque RMS (N·m) | holding torque error (%) | lock time error (ms) | flags |");
     let _ = writeln!(s, "|---|---|---|---|---|---|");
     for sc in r["paper_scenes"].as_array().into_iter().flatten() {

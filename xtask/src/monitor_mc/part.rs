@@ -2,6 +2,7 @@
 //! (seed, plant family, the monitor's configuration digest, pre-roll, the campaign's size) and
 //! the runs it covers; merge refuses parts that do not belong together, overlap or leave gaps.
 
+use host_tests::dormant::Verdict;
 use host_tests::mc::{Context, Outcome, FAULT_KINDS};
 use noback::digest::Fnv1a;
 use noback::monitor::Config;
@@ -24,6 +25,9 @@ pub struct Campaign {
     pub runs: u64,
     /// Runs per fault kind of the whole campaign.
     pub fault_runs: u64,
+    /// The functional test's share of nominal runs (`host_tests::mc::Campaign::test_every`).
+    #[serde(default)]
+    pub test_every: u64,
 }
 
 /// One fault run's outcome.
@@ -36,6 +40,9 @@ pub struct FaultRun {
     pub context: Option<String>,
     pub false_flags: usize,
     pub error: Option<String>,
+    /// The functional test after the run: `rejected`, `pass` or `fail`; absent if not run.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub test: Option<String>,
 }
 
 /// A nominal run the twin could not run.
@@ -62,6 +69,9 @@ pub struct Part {
     #[serde(default)]
     pub not_driven_runs: Vec<u64>,
     pub nominal_errors: Vec<RunError>,
+    /// The nominal runs the functional test followed, each `(index, verdict)`.
+    #[serde(default)]
+    pub nominal_tests: Vec<(u64, String)>,
     /// Every fault run, kind by kind in `FAULT_KINDS` order, each by index.
     pub fault_runs: Vec<FaultRun>,
 }
@@ -80,6 +90,21 @@ pub fn config_digest(config: &Config) -> String {
 pub fn slice(total: u64, k: u64, n: u64) -> Range<u64> {
     let at = |i: u64| (u128::from(total) * u128::from(i) / u128::from(n.max(1))) as u64;
     at(k)..at(k + 1)
+}
+
+fn verdict_tag(v: Verdict) -> &'static str {
+    match v {
+        Verdict::Rejected => "rejected",
+        Verdict::Pass => "pass",
+        Verdict::Fail => "fail",
+    }
+}
+
+fn verdict_of(tag: &str) -> Result<Verdict, String> {
+    [Verdict::Rejected, Verdict::Pass, Verdict::Fail]
+        .into_iter()
+        .find(|v| verdict_tag(*v) == tag)
+        .ok_or_else(|| format!("unknown functional-test verdict `{tag}`"))
 }
 
 fn context_tag(c: Context) -> &'static str {
@@ -120,11 +145,16 @@ impl Part {
             false_alarm_runs: nominal_where(|o| o.counts_as_nominal() && o.false_flags > 0),
             not_driven_runs: nominal_where(|o| o.error.is_none() && o.not_driven),
             nominal_errors: nominal
+                .clone()
                 .zip(nom)
                 .filter_map(|(index, o)| {
                     let error = o.error.clone()?;
                     Some(RunError { index, error })
                 })
+                .collect(),
+            nominal_tests: nominal
+                .zip(nom)
+                .filter_map(|(index, o)| Some((index, verdict_tag(o.test?).to_string())))
                 .collect(),
             fault_runs: fault_indices
                 .zip(flt)
@@ -136,6 +166,7 @@ impl Part {
                     context: o.context.map(|c| context_tag(c).into()),
                     false_flags: o.false_flags,
                     error: o.error.clone(),
+                    test: o.test.map(|v| verdict_tag(v).into()),
                 })
                 .collect(),
         }
@@ -165,6 +196,7 @@ fn outcome_of(r: &FaultRun) -> Result<Outcome, String> {
         false_flags: r.false_flags,
         error: r.error.clone(),
         not_driven: false,
+        test: r.test.as_deref().map(verdict_of).transpose()?,
     })
 }
 
@@ -247,6 +279,13 @@ fn check(name: &str, p: &Part, first: &(String, Campaign)) -> Result<(), String>
             f.pre_roll_s.to_string(),
         );
     }
+    if c.test_every != f.test_every {
+        return differs(
+            "functional-test share",
+            c.test_every.to_string(),
+            f.test_every.to_string(),
+        );
+    }
     if (c.runs, c.fault_runs) != (f.runs, f.fault_runs) {
         return differs(
             "campaign size",
@@ -258,6 +297,7 @@ fn check(name: &str, p: &Part, first: &(String, Campaign)) -> Result<(), String>
     if !p.false_alarm_runs.iter().all(in_nominal)
         || !p.not_driven_runs.iter().all(in_nominal)
         || !p.nominal_errors.iter().all(|e| in_nominal(&e.index))
+        || !p.nominal_tests.iter().all(|(i, _)| in_nominal(i))
     {
         return Err(format!("{name}: names a nominal run outside its range"));
     }
@@ -300,6 +340,7 @@ pub fn merge(parts: &[(String, Part)], prefix: bool) -> Result<(Campaign, Vec<Ou
             false_flags: 0,
             error: None,
             not_driven: false,
+            test: None,
         };
         c.runs as usize
     ];
@@ -313,6 +354,9 @@ pub fn merge(parts: &[(String, Part)], prefix: bool) -> Result<(Campaign, Vec<Ou
         }
         for e in &p.nominal_errors {
             nominal[e.index as usize].error = Some(e.error.clone());
+        }
+        for (i, v) in &p.nominal_tests {
+            nominal[*i as usize].test = Some(verdict_of(v).map_err(|e| format!("{name}: {e}"))?);
         }
         for r in &p.fault_runs {
             let o = outcome_of(r).map_err(|e| format!("{name}: {e}"))?;

@@ -5,6 +5,7 @@
 
 use crate::replay::twin_trace;
 use host_tests::accuracy::{compare, run_monitor};
+use host_tests::dormant::Verdict;
 use host_tests::mc::{Context, Outcome, DETECTION_WINDOW_S, FAULT_KINDS};
 use host_tests::stats::clopper_pearson;
 use noback::monitor::Config;
@@ -95,9 +96,26 @@ pub fn build(meta: &Meta, outcomes: &[Outcome]) -> Result<Value, String> {
                 })
             })
             .collect();
+        // Dormant: the fault never showed to the sensors in its scene; found by the
+        // functional test after the run (the physical form only can run it).
+        let dormant: Vec<&Outcome> = runs.iter().copied().filter(|o| !o.manifested).collect();
+        let tested: Vec<&Outcome> = dormant
+            .iter()
+            .copied()
+            .filter(|o| matches!(o.test, Some(Verdict::Pass | Verdict::Fail)))
+            .collect();
+        let found = tested
+            .iter()
+            .filter(|o| o.test == Some(Verdict::Fail))
+            .count();
         rows.push(json!({
             "kind": format!("{kind:?}"),
             "runs": runs.len(),
+            "dormant": dormant.len(),
+            "dormant_tested": tested.len(),
+            "dormant_found": found,
+            "dormant_found_rate": rate(found, tested.len()),
+            "dormant_rejected_at_acceptance": dormant.iter().filter(|o| o.test == Some(Verdict::Rejected)).count(),
             "manifested": manifested.len(),
             "detected_within_window": hits,
             "detection_rate": detection,
@@ -124,12 +142,26 @@ pub fn build(meta: &Meta, outcomes: &[Outcome]) -> Result<Value, String> {
         "door_cycles_per_flight_hour": DOOR_CYCLES_PER_FLIGHT_HOUR,
         "runs_per_door_cycle": RUNS_PER_DOOR_CYCLE,
         "false_alarm_per_flight_hour_upper95": per_hour,
+        "functional_tests_nominal": functional_tests(&nominal),
         "fault_kinds": rows,
         "twin_errors": errors,
         "not_driven_runs": not_driven,
         "paper_scenes": paper_scenes()?,
         "targets_met": all_ok,
     }))
+}
+
+/// The functional tests after nominal runs: tested in service, failed (a false fail), and
+/// healthy units rejected at their acceptance test against the design.
+fn functional_tests(nominal: &[&Outcome]) -> Value {
+    let count = |v: Verdict| nominal.iter().filter(|o| o.test == Some(v)).count();
+    let (pass, fail) = (count(Verdict::Pass), count(Verdict::Fail));
+    json!({
+        "tested": pass + fail,
+        "failed": fail,
+        "failed_rate": rate(fail, pass + fail),
+        "rejected_at_acceptance": count(Verdict::Rejected),
+    })
 }
 
 /// Accuracy on the paper's scenes (physical reading), for the same page.

@@ -99,6 +99,7 @@ fn merge_refuses_parts_that_do_not_belong_together() {
                 false_flags: 0,
                 error: None,
                 not_driven: false,
+                test: None,
             })
             .collect();
         Part::new(c.clone(), [0, 1], nominal, faults, &outcomes)

@@ -1,0 +1,119 @@
+//! The commanded functional test on the plant family (issue 17): each draw of `monitor-mc
+//! --family plant` in the physical form (the paper reading cannot run the test) becomes a
+//! `functional_test` scene at its drawn load, run healthy and with a dormant holding fault of
+//! severity 0.5…1 (spring_broken, ramp_jam, pack_wear). Uncommissioned the test expects the
+//! design's breakaway ([`TestConfig::DEFAULT`]); commissioned, the unit's own breakaway at its
+//! acceptance test ([`TestConfig::commissioned`]). The tests in service run at a load within
+//! ±5 % of the procedure's and with fresh sensor noise. Prints pass/fail counts.
+//!
+//! `cargo run --release -p host-tests --example functional_test_family -- [RUNS] [SEED]`
+//! (defaults 200, 4242).
+
+use host_tests::accuracy::{run_functional_test, scene_trace};
+use host_tests::dormant;
+use host_tests::family::Family;
+use host_tests::mc::{draw_in, run_rng};
+use noback::monitor::functional_test::{TestConfig, TestResult};
+use noback::monitor::Config;
+use noback_twin::fault::{Fault, FaultKind};
+use noback_twin::reading::Reading;
+use noback_twin::scene::{Scene, DEFAULT_TEST};
+
+/// The draw's plant at `load_nm`, with one fault of `(kind, severity)` if given.
+fn test_scene(base: &Scene, load_nm: f64, fault: Option<(FaultKind, f64)>) -> Scene {
+    let faults: Vec<Fault> = fault
+        .map(|(k, s)| dormant::from_start(k, s))
+        .into_iter()
+        .collect();
+    dormant::test_scene(base, load_nm, &faults)
+}
+
+fn main() -> Result<(), String> {
+    let mut args = std::env::args().skip(1);
+    let runs: u64 = args
+        .next()
+        .map_or(Ok(200), |s| s.parse())
+        .map_err(|e| format!("RUNS: {e}"))?;
+    let seed: u64 = args
+        .next()
+        .map_or(Ok(4242), |s| s.parse())
+        .map_err(|e| format!("SEED: {e}"))?;
+    let kinds = [
+        FaultKind::SpringBroken,
+        FaultKind::RampJam,
+        FaultKind::PackWear,
+    ];
+    // [healthy, per kind] × [uncommissioned, commissioned]: (runs, failed or aborted)
+    let mut tally = [[(0usize, 0usize); 2]; 4];
+    let mut margins = Vec::new();
+    // Commissioned: the healthy re-tests' lowest margin, the faulted runs' highest.
+    let (mut healthy_min, mut faulted_max) = (f64::INFINITY, 0.0_f64);
+    for i in 0..runs {
+        let d = draw_in(Family::Plant, seed, i, None);
+        if d.scene.reading != Reading::Physical || d.scene.load_torque_nm < 2.0 {
+            continue;
+        }
+        let load = d.scene.load_torque_nm;
+        let test = TestConfig {
+            load_nm: load,
+            ..TestConfig::DEFAULT
+        };
+        let start = DEFAULT_TEST.start_s;
+        let accepted = scene_trace(&test_scene(&d.scene, load, None))?;
+        let r0 = run_functional_test(&accepted, Config::default(), &test, start)?;
+        let commissioned = TestConfig::commissioned(load, r0.breakaway_torque_nm.to_num::<f64>());
+        let mut rng = run_rng(seed ^ 0x17, i, None);
+        for (slot, fault) in std::iter::once(None)
+            .chain(kinds.iter().map(Some))
+            .enumerate()
+        {
+            let mut scene = test_scene(
+                &d.scene,
+                load * (1.0 + 0.05 * (2.0 * rng.uniform() - 1.0)),
+                fault.map(|&k| (k, 0.5 + 0.5 * rng.uniform())),
+            );
+            scene.noise.seed = rng.next_u64();
+            let trace = scene_trace(&scene)?;
+            if fault.is_none() {
+                let r = run_functional_test(&trace, Config::default(), &test, start)?;
+                margins.push(r.margin.to_num::<f64>());
+            }
+            for (c, cfg) in [test, commissioned].iter().enumerate() {
+                let r = run_functional_test(&trace, Config::default(), cfg, start)?;
+                if c == 1 {
+                    let m = r.margin.to_num::<f64>();
+                    if fault.is_none() {
+                        healthy_min = healthy_min.min(m);
+                    } else if r.result == TestResult::Pass
+                        || fault == Some(&FaultKind::SpringBroken)
+                    {
+                        faulted_max = faulted_max.max(m);
+                    }
+                }
+                let t = &mut tally[slot][c];
+                t.0 += 1;
+                t.1 += usize::from(r.result != TestResult::Pass);
+            }
+        }
+    }
+    margins.sort_by(f64::total_cmp);
+    let q = |p: f64| {
+        margins
+            .get(((margins.len() as f64 - 1.0) * p) as usize)
+            .copied()
+            .unwrap_or(f64::NAN)
+    };
+    println!("seed {seed}: healthy uncommissioned margin min {:.3} p5 {:.3} median {:.3} p95 {:.3} max {:.3}", q(0.0), q(0.05), q(0.5), q(0.95), q(1.0));
+    println!("commissioned: healthy margin min {healthy_min:.3}, spring_broken margin max {faulted_max:.3}");
+    for (slot, name) in ["healthy", "spring_broken", "ramp_jam", "pack_wear"]
+        .iter()
+        .enumerate()
+    {
+        let [u, c] = tally[slot];
+        println!(
+            "{name:>14}: uncommissioned {}/{} not passed, commissioned {}/{} not passed",
+            u.1, u.0, c.1, c.0
+        );
+    }
+    Ok(())
+}

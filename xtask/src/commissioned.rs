@@ -1,0 +1,92 @@
+//! A commissioned unit on the firmware under QEMU (`cargo xtask test`): its configuration block
+//! runs bit-exact with the host, and its functional test says what the host's says.
+
+use crate::cores::Core;
+use crate::run;
+
+/// The paper reading's reverse_load commissioned from itself (a spring-only pack, another
+/// form than the defaults'), its configuration handed to the firmware as a block: the firmware
+/// must say it runs on the block and stay bit-exact with the host on the same configuration,
+/// whose estimates differ from the uncommissioned ones (on the STM32F405 the block sits in its
+/// configuration sector, as commissioning writes it).
+pub fn block_is_bit_exact(core: Core) -> Result<(), String> {
+    let dir = crate::shell::workspace_root().join("target").join("replay");
+    std::fs::create_dir_all(&dir).map_err(|e| e.to_string())?;
+    let scene = dir.join("paper_reverse_load.toml");
+    std::fs::write(
+        &scene,
+        "[scene]\nkind = \"reverse_load\"\nreading = \"paper\"\n",
+    )
+    .map_err(|e| e.to_string())?;
+    let scene = scene.to_string_lossy().into_owned();
+    let trace = crate::replay::twin_trace(&scene)?;
+    let c = host_tests::commission::commission(&[(&trace, 20.3)])?;
+    let (report, ok) = run::replay_report_with(&scene, core, None, None, false, Some(c.config))?;
+    let uncommissioned = crate::replay::host_run(
+        &crate::replay::nbr1(&trace)?,
+        &[],
+        None,
+        noback::monitor::Config::default(),
+    )?;
+    let other = format!("{:#010x}", uncommissioned.totals.digest);
+    println!(
+        "configuration {} ({:?}), bit_exact {}, firmware digest {} (uncommissioned {other})",
+        report["configuration"],
+        c.config.driving_pack,
+        report["bit_exact"],
+        report["firmware_digest"]
+    );
+    if ok && report["configuration"] == "block" && report["firmware_digest"] != other.as_str() {
+        Ok(())
+    } else {
+        Err("the commissioned firmware did not run on its block bit-exactly".into())
+    }
+}
+
+/// The crew's functional test under QEMU, its report equal to the host's (`run` checks it):
+/// a healthy unit commissioned on its own acceptance test passes, the same unit with its spring
+/// half gone fails (docs/functional-test.md).
+pub fn functional_test_on_firmware() -> Result<(), String> {
+    let dir = crate::shell::workspace_root().join("target").join("replay");
+    std::fs::create_dir_all(&dir).map_err(|e| e.to_string())?;
+    let opening = crate::replay::twin_trace("reverse_load")?;
+    let test = crate::replay::twin_trace("functional_test")?;
+    let mut c = host_tests::commission::commission(&[(&opening, 20.3)])?.config;
+    let accepted = host_tests::accuracy::run_functional_test(&test, c, &c.functional_test, 0.2)?;
+    c.functional_test = noback::monitor::functional_test::TestConfig::commissioned(
+        20.3,
+        accepted.breakaway_torque_nm.to_num(),
+    );
+    let spring = dir.join("functional_test_spring_half.toml");
+    std::fs::write(
+        &spring,
+        "[scene]\nkind = \"functional_test\"\n[[fault]]\nkind = \"spring_broken\"\nat_s = 0.0\nseverity = 0.5\n",
+    )
+    .map_err(|e| e.to_string())?;
+    let mut verdicts = Vec::new();
+    for scene in [
+        "functional_test".to_string(),
+        spring.to_string_lossy().into_owned(),
+    ] {
+        let (report, ok) = run::replay_report_with(&scene, Core::M3, None, None, false, Some(c))?;
+        println!("{scene}: {}", report["functional_test"]);
+        if !ok {
+            return Err(format!(
+                "{scene}: the firmware's test differs from the host's or the run failed"
+            ));
+        }
+        verdicts.push(
+            report["functional_test"]["result"]
+                .as_str()
+                .unwrap_or("")
+                .to_string(),
+        );
+    }
+    if verdicts == ["pass", "fail"] {
+        Ok(())
+    } else {
+        Err(format!(
+            "functional test verdicts {verdicts:?}, expected pass then fail"
+        ))
+    }
+}
