@@ -61,7 +61,7 @@ fn main() -> Result<(), String> {
         let start = DEFAULT_TEST.start_s;
         let accepted = scene_trace(&test_scene(&d.scene, load, None))?;
         let r0 = run_functional_test(&accepted, Config::default(), &test, start)?;
-        let commissioned = TestConfig::commissioned(load, r0.breakaway_torque_nm.to_num::<f64>());
+        let commissioned = test.commissioned(r0.breakaway_torque_nm.to_num::<f64>());
         let mut rng = run_rng(seed ^ 0x17, i, None);
         for (slot, fault) in std::iter::once(None)
             .chain(kinds.iter().map(Some))

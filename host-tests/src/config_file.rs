@@ -234,7 +234,11 @@ mod tests {
         c.sliding_mu = 0.2345678901;
         c.driving_pack = DrivingPack::SpringOnly;
         c.thresholds.creep_limit_rad = 0.125;
-        c.functional_test = TestConfig::commissioned(18.5, 10.25);
+        c.functional_test = TestConfig {
+            load_nm: 18.5,
+            ..TestConfig::DEFAULT
+        }
+        .commissioned(10.25);
         let text = write(&c, "test").unwrap();
         assert_eq!(parse(&text), Ok(c), "{text}");
         let mut other = c;

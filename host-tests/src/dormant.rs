@@ -1,8 +1,9 @@
-//! Dormant faults: the commanded functional test at the end of a Monte Carlo run
-//! (docs/monitor.md, "Dormant faults"). The unit is commissioned by its healthy acceptance test
-//! at the procedure's load; in service the test runs with the run's faults in place, at a load
-//! within ±5 % of the procedure's and with fresh sensor noise. Only the physical form can run
-//! it (the paper reading's drive along the load takes no torque).
+//! The commanded functional test on the host (docs/functional-test.md): a scene's procedure, a
+//! unit's acceptance, and the test at the end of a Monte Carlo run that finds dormant faults
+//! (docs/monitor.md). There the unit is commissioned by its healthy acceptance test at the
+//! procedure's load; in service the test runs with the run's faults in place, at a load within
+//! ±5 % of the procedure's and with fresh sensor noise. Only the physical form can run it (the
+//! paper reading's drive along the load takes no torque).
 
 use crate::accuracy::{run_functional_test, scene_trace};
 use crate::mc::Draw;
@@ -12,6 +13,7 @@ use noback_twin::fault::{Fault, FaultKind};
 use noback_twin::reading::Reading;
 use noback_twin::scene::{Scene, SceneKind};
 use noback_twin::sensing::Rng;
+use noback_twin::trace::Trace;
 
 /// How far the in-service test's load may lie from the procedure's (fraction).
 pub const LOAD_TOLERANCE: f64 = 0.05;
@@ -28,6 +30,29 @@ pub fn test_scene(base: &Scene, load_nm: f64, faults: &[Fault]) -> Scene {
     s.open = base.open;
     s.faults = faults.iter().map(|f| Fault { at_s: 0.0, ..*f }).collect();
     s
+}
+
+/// The procedure a `functional_test` scene runs: its load and its drive's ramp.
+pub fn procedure_of(scene: &Scene) -> TestConfig {
+    TestConfig {
+        load_nm: scene.load_torque_nm,
+        torque_rate_nm_s: scene.test.torque_rate_nm_s,
+        max_torque_nm: scene.test.torque_max_nm,
+        ..TestConfig::DEFAULT
+    }
+}
+
+/// The acceptance test: `procedure` run on a healthy unit's `trace` (requested at `start_s`)
+/// against the design; if it passes, the procedure commissioned on its breakaway, else `None`.
+pub fn accept(
+    trace: &Trace,
+    config: Config,
+    procedure: &TestConfig,
+    start_s: f64,
+) -> Result<Option<TestConfig>, String> {
+    let r = run_functional_test(trace, config, procedure, start_s)?;
+    Ok((r.result == TestResult::Pass)
+        .then(|| procedure.commissioned(r.breakaway_torque_nm.to_num())))
 }
 
 /// A fault of `kind` and `severity` present from the start.
@@ -61,12 +86,9 @@ pub fn functional_test_after(d: &Draw, config: Config) -> Result<Option<Verdict>
     let mut rng = Rng::new(d.scene.noise.seed ^ 0x7e57);
     let mut accepted = test_scene(&d.scene, procedure.load_nm, &[]);
     accepted.noise.seed = rng.next_u64();
-    let accepted = scene_trace(&accepted)?;
-    let r = run_functional_test(&accepted, config, &procedure, start)?;
-    if r.result != TestResult::Pass {
+    let Some(commissioned) = accept(&scene_trace(&accepted)?, config, &procedure, start)? else {
         return Ok(Some(Verdict::Rejected));
-    }
-    let commissioned = TestConfig::commissioned(procedure.load_nm, r.breakaway_torque_nm.to_num());
+    };
     let load = procedure.load_nm * (1.0 + LOAD_TOLERANCE * (2.0 * rng.uniform() - 1.0));
     let mut in_service = test_scene(&d.scene, load, &d.scene.faults);
     in_service.noise.seed = rng.next_u64();

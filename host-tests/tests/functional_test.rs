@@ -41,7 +41,7 @@ fn a_healthy_brake_passes_at_its_design_capacity() {
 #[test]
 fn a_commissioned_unit_fails_with_half_its_spring() {
     let accepted = report(None, &TestConfig::DEFAULT);
-    let test = TestConfig::commissioned(20.3, accepted.breakaway_torque_nm.to_num());
+    let test = TestConfig::DEFAULT.commissioned(accepted.breakaway_torque_nm.to_num());
     assert_eq!(report(None, &test).result, TestResult::Pass);
     let r = report(Some((FaultKind::SpringBroken, 0.5)), &test);
     assert_eq!(r.result, TestResult::Fail, "{r:?}");

@@ -16,8 +16,9 @@
 //! | margin | [`Q16`], capacity over expected | 0 … 32 768 | 1.5e-5 |
 
 use super::config::{Config, ConfigError};
-use super::convert::{exp_neg, finite, gain, positive, q16, require};
+use super::convert::{filter_gain, finite, positive, q16, require, ticks};
 use super::io::Flags;
+use super::schedule::EVERY_TICK;
 use super::sense::Sensed;
 use crate::fx::{counter_delta, lowpass, Gain, Q16};
 
@@ -60,15 +61,14 @@ impl TestConfig {
         torque_filter_hz: 50.0,
     };
 
-    /// The test of a unit whose acceptance test broke away at `breakaway_nm` under `load_nm`:
-    /// pass at [`COMMISSIONED_MIN_MARGIN`] of that capacity.
-    pub fn commissioned(load_nm: f64, breakaway_nm: f64) -> TestConfig {
+    /// This procedure on a unit whose acceptance test under it broke away at `breakaway_nm`:
+    /// pass within [`COMMISSIONED_MIN_MARGIN`] … [`COMMISSIONED_MAX_MARGIN`] of that capacity.
+    pub fn commissioned(self, breakaway_nm: f64) -> TestConfig {
         TestConfig {
-            load_nm,
             expected_breakaway_nm: Some(breakaway_nm),
             min_margin: COMMISSIONED_MIN_MARGIN,
             max_margin: COMMISSIONED_MAX_MARGIN,
-            ..TestConfig::DEFAULT
+            ..self
         }
     }
 }
@@ -136,8 +136,6 @@ impl TestSettings {
         require(counts < 1e6, "functional_test.breakaway_rad")?;
         let hz = positive(t.torque_filter_hz, "functional_test.torque_filter_hz")?;
         let tick_hz = positive(c.tick_hz, "tick_hz")?;
-        let ramp_s = max / rate + 5.0 / hz;
-        require(ramp_s * tick_hz < 4e9, "functional_test.torque_rate_nm_s")?;
         Ok(TestSettings {
             sign: if load > 0.0 { 1 } else { -1 },
             load: q16(l, "functional_test.load_nm")?,
@@ -145,14 +143,15 @@ impl TestSettings {
             expected_capacity: q16(expected, "functional_test.expected_breakaway_nm")?,
             min_capacity: q16(expected * margin, "functional_test.min_margin")?,
             max_capacity: q16(expected * top, "functional_test.max_margin")?,
-            limit_ticks: (ramp_s * tick_hz) as u32, // < 4e9 (checked above)
+            limit_ticks: ticks(
+                max / rate + 5.0 / hz,
+                tick_hz,
+                "functional_test.torque_rate_nm_s",
+            )?,
             // 0 < counts < 1e6 (checked above): the next whole count, at least 1.
             breakaway_counts: (counts as i32 + 1).max(1),
             out_bits: bits,
-            alpha: gain(
-                1.0 - exp_neg(core::f64::consts::TAU * hz / tick_hz),
-                "functional_test.torque_filter_hz",
-            )?,
+            alpha: filter_gain(hz, tick_hz, EVERY_TICK, "functional_test.torque_filter_hz")?,
         })
     }
 }
@@ -200,7 +199,6 @@ pub struct TestReport {
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct FunctionalTest {
     rest_count: Option<u32>,
-    travel: i32,
     ticks: u32,
     torque: Q16,
     report: TestReport,
@@ -211,7 +209,6 @@ impl FunctionalTest {
     pub fn new() -> FunctionalTest {
         FunctionalTest {
             rest_count: None,
-            travel: 0,
             ticks: 0,
             torque: Q16::ZERO,
             report: TestReport {
@@ -241,7 +238,7 @@ impl FunctionalTest {
             return self.report;
         }
         let rest = *self.rest_count.get_or_insert(x.out);
-        self.travel = s.sign * counter_delta(rest, x.out, s.out_bits);
+        let travel = s.sign * counter_delta(rest, x.out, s.out_bits);
         let along = if s.sign > 0 {
             drive_torque
         } else {
@@ -250,7 +247,7 @@ impl FunctionalTest {
         self.torque = lowpass(self.torque, along, s.alpha);
         self.report.breakaway_torque_nm = self.report.breakaway_torque_nm.max(self.torque);
         self.ticks = self.ticks.saturating_add(x.n);
-        if self.travel >= s.breakaway_counts {
+        if travel >= s.breakaway_counts {
             let t_b = self.report.breakaway_torque_nm;
             let capacity = s.load.saturating_add(s.lever.saturating_mul(t_b));
             self.report.capacity_nm = capacity;

@@ -12,6 +12,7 @@
 //! | 2 [`Slot::Checks`] | capacity margin, common slip (drive off), drive checks (drive on) | `checks` |
 //! | 3, by [`WINDOW`] (625 Hz): 7 / 15 | synchronism window / dead-current block (drive on) | `scene`, `checks` |
 //!
+//! After every slot's work, while the crew has requested it, the functional test ([`EVERY_TICK`]).
 //! The braking model (`tick_hz / braking_model_hz`) steps on odd ticks. A lane's filter gains
 //! and persistence counts are those of its own rate: each part counts the ticks it covers.
 
@@ -42,6 +43,8 @@ impl Lane {
 
 /// The slow lane: 2.5 kHz at 10 kHz.
 pub const SLOW: Lane = Lane { ticks: 4 };
+/// Every tick, in the slow lane's context: the commanded functional test, while requested.
+pub const EVERY_TICK: Lane = Lane { ticks: 1 };
 /// The window lane: 625 Hz at 10 kHz (1.6 ms windows).
 pub const WINDOW: Lane = Lane { ticks: 16 };
 

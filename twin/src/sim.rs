@@ -153,11 +153,10 @@ pub fn run_model_with<M: TwinModel, I: SegmentSolver>(
             },
         )?;
         t = b;
-        let angle = samples.last().map_or(0.0, |s| s.output_angle_rad);
-        if t >= scene.test.start_s {
+        if scene.kind == SceneKind::FunctionalTest && t >= scene.test.start_s {
+            let angle = samples.last().map_or(0.0, |s| s.output_angle_rad);
             let rest = *rest_angle.get_or_insert(angle);
-            aborted |= scene.kind == SceneKind::FunctionalTest
-                && (angle - rest).abs() >= scene.test.abort_angle_rad;
+            aborted |= (angle - rest).abs() >= scene.test.abort_angle_rad;
         }
         model.set_drive(scene_drive(scene, t, !aborted), &mut y);
         model.set_faults(PhysicsFaults::at(&scene.faults, t), &mut y);

@@ -3,8 +3,7 @@
 //! monitor's configuration file (`host_tests::config_file`).
 
 use crate::replay::trace_of;
-use host_tests::accuracy::run_functional_test;
-use noback::monitor::functional_test::{TestConfig, TestResult};
+use host_tests::dormant::{accept, procedure_of};
 use noback_twin::args::bad_input;
 use noback_twin::scene::SceneKind;
 use noback_twin::trace::Trace;
@@ -74,28 +73,19 @@ pub fn main(a: &CommissionArgs) -> Result<i32, String> {
     };
     let mut test_note = String::new();
     if let Some((trace, scene)) = &test_run {
-        let procedure = TestConfig {
-            load_nm: scene.load_torque_nm,
-            torque_rate_nm_s: scene.test.torque_rate_nm_s,
-            max_torque_nm: scene.test.torque_max_nm,
-            ..TestConfig::DEFAULT
-        };
-        let r = run_functional_test(trace, c.config, &procedure, scene.test.start_s)?;
-        if r.result != TestResult::Pass {
+        let procedure = procedure_of(scene);
+        let Some(mut t) = accept(trace, c.config, &procedure, scene.test.start_s)? else {
             return Ok(bad_input(
                 "commission",
-                &format!(
-                    "the acceptance functional test did not pass ({:?}): the unit is not healthy",
-                    r.result
-                ),
+                "the acceptance functional test did not pass: the unit is not healthy",
             ));
-        }
-        let b = (r.breakaway_torque_nm.to_num::<f64>() * 1e3).round() / 1e3;
-        c.config.functional_test = TestConfig {
-            torque_rate_nm_s: procedure.torque_rate_nm_s,
-            max_torque_nm: procedure.max_torque_nm,
-            ..TestConfig::commissioned(procedure.load_nm, b)
         };
+        // The file carries the breakaway to the millinewton-metre.
+        let b = t
+            .expected_breakaway_nm
+            .map_or(0.0, |b| (b * 1e3).round() / 1e3);
+        t.expected_breakaway_nm = Some(b);
+        c.config.functional_test = t;
         test_note = format!(
             ", functional test breakaway {b} N·m at {} N·m",
             procedure.load_nm

@@ -52,11 +52,9 @@ pub fn functional_test_on_firmware() -> Result<(), String> {
     let opening = crate::replay::twin_trace("reverse_load")?;
     let test = crate::replay::twin_trace("functional_test")?;
     let mut c = host_tests::commission::commission(&[(&opening, 20.3)])?.config;
-    let accepted = host_tests::accuracy::run_functional_test(&test, c, &c.functional_test, 0.2)?;
-    c.functional_test = noback::monitor::functional_test::TestConfig::commissioned(
-        20.3,
-        accepted.breakaway_torque_nm.to_num(),
-    );
+    let start = noback_twin::scene::DEFAULT_TEST.start_s;
+    c.functional_test = host_tests::dormant::accept(&test, c, &c.functional_test, start)?
+        .ok_or("the healthy unit did not pass its acceptance test")?;
     let spring = dir.join("functional_test_spring_half.toml");
     std::fs::write(
         &spring,

@@ -9,7 +9,6 @@ use host_tests::accuracy::run_functional_test;
 use host_tests::accuracy::{
     compare, detection_latency_s, false_alarms, manifest_time, run_monitor, COMPARE_WINDOW_S,
 };
-use noback::monitor::functional_test::TestConfig;
 use noback::monitor::Config;
 use noback_twin::scene::{Scene, SceneKind};
 use noback_twin::svg::{render, Panel, Series};
@@ -54,12 +53,7 @@ fn functional_test_json(
     config: Config,
     scene: &Scene,
 ) -> Result<serde_json::Value, String> {
-    let test = TestConfig {
-        load_nm: scene.load_torque_nm,
-        torque_rate_nm_s: scene.test.torque_rate_nm_s,
-        max_torque_nm: scene.test.torque_max_nm,
-        ..TestConfig::DEFAULT
-    };
+    let test = host_tests::dormant::procedure_of(scene);
     let r = run_functional_test(trace, config, &test, scene.test.start_s)?;
     Ok(json!({
         "result": format!("{:?}", r.result).to_lowercase(),

@@ -169,15 +169,8 @@ pub fn main(a: &RunArgs) -> Result<i32, String> {
 /// is a `functional_test` scene.
 fn functional_test_of(scene: &str) -> Option<(TestConfig, f64)> {
     let s = noback_twin::cli::load_scene(scene, None).ok()?;
-    (s.kind == SceneKind::FunctionalTest).then(|| {
-        let test = TestConfig {
-            load_nm: s.load_torque_nm,
-            torque_rate_nm_s: s.test.torque_rate_nm_s,
-            max_torque_nm: s.test.torque_max_nm,
-            ..TestConfig::DEFAULT
-        };
-        (test, s.test.start_s)
-    })
+    (s.kind == SceneKind::FunctionalTest)
+        .then(|| (host_tests::dormant::procedure_of(&s), s.test.start_s))
 }
 
 /// Runs a scene through the firmware under QEMU and the host; returns the summary and whether

@@ -246,15 +246,14 @@ impl Physical {
         let axial_f = lossy * mu_d * m.connecting_shaft_mass_kg * g;
         q[X_B] -= axial_f * smooth_sign(at(y, X_B + 1), vsm);
         q[X_M] -= axial_f * smooth_sign(at(y, X_M + 1), vsm);
-        // Ball friction F_bf = μ·|F_c1 − F_c2| along the axis (cos θ component).
-        let mu_b = mu_d;
+        // Ball friction F_bf = μ_d·|F_c1 − F_c2| along the axis (cos θ component).
         let cth = m.socket_chamfer_rad.cos();
         let f1 = contact_n[0];
         let f2 = contact_n[1] + contact_n[2];
-        q[X_O] -= lossy * 3.0 * mu_b * (f1 - f2).abs() * cth * smooth_sign(at(y, X_O + 1), vsm);
+        q[X_O] -= lossy * 3.0 * mu_d * (f1 - f2).abs() * cth * smooth_sign(at(y, X_O + 1), vsm);
         let f3 = contact_n[3];
         let f4 = contact_n[4] + contact_n[5];
-        q[X_I] -= lossy * 3.0 * mu_b * (f3 - f4).abs() * cth * smooth_sign(at(y, X_I + 1), vsm);
+        q[X_I] -= lossy * 3.0 * mu_d * (f3 - f4).abs() * cth * smooth_sign(at(y, X_I + 1), vsm);
         // Wave spring (and a drag fault's extra force) on the big shaft.
         q[X_B] +=
             spring_force_n(m, at(y, X_B), self.faults.spring_scale) + self.faults.drag_force_n;
