@@ -1,10 +1,11 @@
 //! The commanded functional test on the plant family (issue 17): each draw of `monitor-mc
 //! --family plant` in the physical form (the paper reading cannot run the test) becomes a
-//! `functional_test` scene at its drawn load, run healthy and with a dormant holding fault of
-//! severity 0.5…1 (spring_broken, ramp_jam, pack_wear). Uncommissioned the test expects the
-//! design's breakaway ([`TestConfig::DEFAULT`]); commissioned, the unit's own breakaway at its
-//! acceptance test ([`TestConfig::commissioned`]). The tests in service run at a load within
-//! ±5 % of the procedure's and with fresh sensor noise. Prints pass/fail counts.
+//! `functional_test` scene at its drawn load, run healthy and with a dormant fault of severity
+//! 0.5…1 (spring_broken, ramp_jam, pack_wear, and current_open: a current sensor's gain lost). Uncommissioned the test expects the
+//! design's breakaway ([`TestConfig::DEFAULT`]); commissioned, the unit's own breakaway and
+//! opening torque at its acceptance test ([`TestConfig::commissioned`]), and for comparison its
+//! breakaway alone. The tests in service run at a load within ±5 % of the procedure's and with
+//! fresh sensor noise. Prints pass/fail counts.
 //!
 //! `cargo run --release -p host-tests --example functional_test_family -- [RUNS] [SEED]`
 //! (defaults 200, 4242).
@@ -42,12 +43,15 @@ fn main() -> Result<(), String> {
         FaultKind::SpringBroken,
         FaultKind::RampJam,
         FaultKind::PackWear,
+        FaultKind::CurrentOpen,
     ];
-    // [healthy, per kind] × [uncommissioned, commissioned]: (runs, failed or aborted)
-    let mut tally = [[(0usize, 0usize); 2]; 4];
+    // [healthy, per kind] × [uncommissioned, breakaway alone, both]: (runs, failed or aborted)
+    let mut tally = [[(0usize, 0usize); 3]; 5];
     let mut margins = Vec::new();
-    // Commissioned: the healthy re-tests' lowest margin, the faulted runs' highest.
-    let (mut healthy_min, mut faulted_max) = (f64::INFINITY, 0.0_f64);
+    // Commissioned on both: the healthy re-tests' margins, the faulted runs' highest.
+    let (mut healthy_c, mut faulted_max) = (Vec::new(), 0.0_f64);
+    // Commissioned on both: the healthy re-tests' implied load over the set one, less one.
+    let mut load_errors = Vec::new();
     for i in 0..runs {
         let d = draw_in(Family::Plant, seed, i, None);
         if d.scene.reading != Reading::Physical || d.scene.load_torque_nm < 2.0 {
@@ -61,7 +65,14 @@ fn main() -> Result<(), String> {
         let start = DEFAULT_TEST.start_s;
         let accepted = scene_trace(&test_scene(&d.scene, load, None))?;
         let r0 = run_functional_test(&accepted, Config::default(), &test, start)?;
-        let commissioned = test.commissioned(r0.breakaway_torque_nm.to_num::<f64>());
+        let commissioned = test.commissioned(
+            r0.breakaway_torque_nm.to_num::<f64>(),
+            r0.opening_torque_nm.to_num::<f64>(),
+        );
+        let alone = TestConfig {
+            expected_opening_nm: None,
+            ..commissioned
+        };
         let mut rng = run_rng(seed ^ 0x17, i, None);
         for (slot, fault) in std::iter::once(None)
             .chain(kinds.iter().map(Some))
@@ -78,12 +89,13 @@ fn main() -> Result<(), String> {
                 let r = run_functional_test(&trace, Config::default(), &test, start)?;
                 margins.push(r.margin.to_num::<f64>());
             }
-            for (c, cfg) in [test, commissioned].iter().enumerate() {
+            for (c, cfg) in [test, alone, commissioned].iter().enumerate() {
                 let r = run_functional_test(&trace, Config::default(), cfg, start)?;
-                if c == 1 {
+                if c == 2 {
                     let m = r.margin.to_num::<f64>();
                     if fault.is_none() {
-                        healthy_min = healthy_min.min(m);
+                        healthy_c.push(m);
+                        load_errors.push(r.load_nm.to_num::<f64>() / load - 1.0);
                     } else if r.result == TestResult::Pass
                         || fault == Some(&FaultKind::SpringBroken)
                     {
@@ -96,23 +108,49 @@ fn main() -> Result<(), String> {
             }
         }
     }
-    margins.sort_by(f64::total_cmp);
-    let q = |p: f64| {
-        margins
-            .get(((margins.len() as f64 - 1.0) * p) as usize)
-            .copied()
-            .unwrap_or(f64::NAN)
+    let spread = |v: &mut Vec<f64>| {
+        v.sort_by(f64::total_cmp);
+        let q = |p: f64| {
+            v.get(((v.len() as f64 - 1.0) * p) as usize)
+                .copied()
+                .unwrap_or(f64::NAN)
+        };
+        format!(
+            "min {:.3} p5 {:.3} median {:.3} p95 {:.3} max {:.3}",
+            q(0.0),
+            q(0.05),
+            q(0.5),
+            q(0.95),
+            q(1.0)
+        )
     };
-    println!("seed {seed}: healthy uncommissioned margin min {:.3} p5 {:.3} median {:.3} p95 {:.3} max {:.3}", q(0.0), q(0.05), q(0.5), q(0.95), q(1.0));
-    println!("commissioned: healthy margin min {healthy_min:.3}, spring_broken margin max {faulted_max:.3}");
-    for (slot, name) in ["healthy", "spring_broken", "ramp_jam", "pack_wear"]
-        .iter()
-        .enumerate()
+    println!(
+        "seed {seed}: healthy uncommissioned margin {}",
+        spread(&mut margins)
+    );
+    println!(
+        "commissioned on both: healthy margin {}",
+        spread(&mut healthy_c)
+    );
+    println!(
+        "commissioned on both: healthy implied load error {}",
+        spread(&mut load_errors)
+    );
+    println!("commissioned on both: spring_broken margin max {faulted_max:.3}");
+    for (slot, name) in [
+        "healthy",
+        "spring_broken",
+        "ramp_jam",
+        "pack_wear",
+        "current_open",
+    ]
+    .iter()
+    .enumerate()
     {
-        let [u, c] = tally[slot];
+        let [u, a, c] = tally[slot];
         println!(
-            "{name:>14}: uncommissioned {}/{} not passed, commissioned {}/{} not passed",
-            u.1, u.0, c.1, c.0
+            "{name:>14}: not passed uncommissioned {}/{}, breakaway alone {}/{}, both {}/{}",
+            u.1, u.0, a.1, a.0, c.1, c.0
         );
     }
     Ok(())

@@ -51,19 +51,26 @@ pub fn monitor_on_scene(scene: &noback_twin::scene::Scene) -> Result<(Trace, Acc
     Ok((trace, acc))
 }
 
-/// Runs the monitor over every row of a trace.
+/// Runs the monitor over every row of a trace, as an ECU that does not hand on the drive's
+/// current command.
 pub fn run_monitor(trace: &Trace, config: Config) -> Result<Vec<Estimate>, String> {
+    run_monitor_with(trace, config, false)
+}
+
+/// [`run_monitor`], with the trace's current command in the inputs when `command` (and the
+/// trace carries it).
+pub fn run_monitor_with(
+    trace: &Trace,
+    config: Config,
+    command: bool,
+) -> Result<Vec<Estimate>, String> {
     let mut monitor = Monitor::new(config).map_err(|e| format!("monitor config: {e:?}"))?;
     Ok(trace
         .rows
         .iter()
         .map(|r| {
-            monitor.step(&Inputs::new(
-                r.current_code,
-                r.motor_count,
-                r.output_count,
-                r.drive_on,
-            ))
+            let i = Inputs::new(r.current_code, r.motor_count, r.output_count, r.drive_on);
+            monitor.step(&i.with_command(r.current_command_code.filter(|_| command)))
         })
         .collect())
 }
@@ -302,6 +309,11 @@ pub fn expected_flag(kind: FaultKind) -> &'static [&'static str] {
 /// a longer one is the brake failing to hold.
 pub const FAILED_HOLD_SLIP_S: f64 = 0.020;
 
+/// The current (A) below which a lost gain cannot be seen: twice the current sensor's offset
+/// tolerance of the plant family (±0.25 A), ten times its noise (≤ 0.1 A σ, averaged). The paper
+/// reading closes on less than 0.25 A (its drive along the load takes no torque).
+pub const VISIBLE_CURRENT_A: f64 = 0.5;
+
 /// How far the output must turn for a failure to hold, or a frozen output reading, to show
 /// (rad): beyond the rattle in the lost motion of a held output (≤ 0.13 rad in 1000 nominal
 /// Monte Carlo draws, docs/monitor-design.md, "Common slip"). Inside it the encoders show what a
@@ -322,15 +334,28 @@ pub const HELD_RATTLE_RAD: f64 = 0.13;
 /// - drag: the first sample at or after the onset with the drive running;
 /// - encoder_jump: at the onset; encoder_stuck: once the true output angle has left its value
 ///   at the onset (the frozen reading) by more than [`HELD_RATTLE_RAD`];
-/// - current_open: the first sample at or after the onset with the drive running (a current is
-///   then expected).
+/// - current_open: the first sample at or after the onset with the drive running and its current
+///   (the trace's command column: the true current) at least [`VISIBLE_CURRENT_A`]; on a trace
+///   without it, the first with the drive running.
 pub fn manifest_time(fault: &Fault, trace: &Trace) -> Option<f64> {
     let rows = &trace.rows;
     let start = rows.iter().position(|r| r.t_s >= fault.at_s)?;
     let after = || rows.iter().skip(start);
     match fault.kind {
         FaultKind::EncoderJump => Some(fault.at_s),
-        FaultKind::Drag | FaultKind::CurrentOpen => after().find(|r| r.drive_on).map(|r| r.t_s),
+        FaultKind::Drag => after().find(|r| r.drive_on).map(|r| r.t_s),
+        FaultKind::CurrentOpen => {
+            let s = noback::sensors::DEFAULT_SENSORS;
+            let mid = 1_i32 << (s.current_adc_bits - 1);
+            let visible = (VISIBLE_CURRENT_A / s.amps_per_count()).round() as i32;
+            after()
+                .find(|r| {
+                    r.drive_on
+                        && r.current_command_code
+                            .is_none_or(|c| (i32::from(c) - mid).abs() >= visible)
+                })
+                .map(|r| r.t_s)
+        }
         FaultKind::EncoderStuck => {
             let angle0 = rows.get(start)?.output_angle_rad;
             after()

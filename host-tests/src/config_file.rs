@@ -15,6 +15,7 @@
 //! [monitor.functional_test]      # the commanded test's procedure (TestConfig's fields)
 //! load_nm = 20.3
 //! expected_breakaway_nm = 11.0   # the unit's acceptance test (absent: the design's)
+//! expected_opening_nm = 24.8     # and its opening torque (needs the breakaway)
 //! min_margin = 0.95
 //! ```
 
@@ -63,15 +64,26 @@ fn thresholds(base: Thresholds, given: Table) -> Result<Thresholds, String> {
 }
 
 /// The functional test's keys and fields, in `TestConfig`'s order.
-fn test_fields(t: &mut TestConfig) -> [(&'static str, &mut f64); 7] {
+fn test_fields(t: &mut TestConfig) -> [(&'static str, &mut f64); 10] {
     [
         ("load_nm", &mut t.load_nm),
         ("torque_rate_nm_s", &mut t.torque_rate_nm_s),
         ("max_torque_nm", &mut t.max_torque_nm),
+        ("open_s", &mut t.open_s),
+        ("settle_s", &mut t.settle_s),
         ("breakaway_rad", &mut t.breakaway_rad),
         ("min_margin", &mut t.min_margin),
         ("max_margin", &mut t.max_margin),
+        ("load_tolerance", &mut t.load_tolerance),
         ("torque_filter_hz", &mut t.torque_filter_hz),
+    ]
+}
+
+/// The functional test's optional keys (the unit's acceptance readings) and fields.
+fn acceptance_fields(t: &mut TestConfig) -> [(&'static str, &mut Option<f64>); 2] {
+    [
+        ("expected_breakaway_nm", &mut t.expected_breakaway_nm),
+        ("expected_opening_nm", &mut t.expected_opening_nm),
     ]
 }
 
@@ -83,9 +95,10 @@ fn functional_test(mut given: Table) -> Result<TestConfig, String> {
             *field = number(&v, &format!("monitor.functional_test.{key}"))?;
         }
     }
-    if let Some(v) = given.remove("expected_breakaway_nm") {
-        t.expected_breakaway_nm =
-            Some(number(&v, "monitor.functional_test.expected_breakaway_nm")?);
+    for (key, field) in acceptance_fields(&mut t) {
+        if let Some(v) = given.remove(key) {
+            *field = Some(number(&v, &format!("monitor.functional_test.{key}"))?);
+        }
     }
     no_more(&given, "monitor.functional_test.")?;
     Ok(t)
@@ -196,8 +209,11 @@ pub fn write(c: &Config, comment: &str) -> Result<String, String> {
             test.push_str(&format!("{key} = {v:?}\n"));
         }
     }
-    if let Some(b) = c.functional_test.expected_breakaway_nm {
-        test.push_str(&format!("expected_breakaway_nm = {b:?}\n"));
+    let mut now = c.functional_test;
+    for (key, v) in acceptance_fields(&mut now) {
+        if let Some(v) = v {
+            test.push_str(&format!("{key} = {v:?}\n"));
+        }
     }
     if !test.is_empty() {
         out.push_str("[monitor.functional_test]\n");
@@ -238,7 +254,7 @@ mod tests {
             load_nm: 18.5,
             ..TestConfig::DEFAULT
         }
-        .commissioned(10.25);
+        .commissioned(10.25, 24.5);
         let text = write(&c, "test").unwrap();
         assert_eq!(parse(&text), Ok(c), "{text}");
         let mut other = c;

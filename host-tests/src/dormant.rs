@@ -38,12 +38,15 @@ pub fn procedure_of(scene: &Scene) -> TestConfig {
         load_nm: scene.load_torque_nm,
         torque_rate_nm_s: scene.test.torque_rate_nm_s,
         max_torque_nm: scene.test.torque_max_nm,
+        open_s: scene.test.open_s,
+        settle_s: scene.test.settle_s,
         ..TestConfig::DEFAULT
     }
 }
 
 /// The acceptance test: `procedure` run on a healthy unit's `trace` (requested at `start_s`)
-/// against the design; if it passes, the procedure commissioned on its breakaway, else `None`.
+/// against the design; if it passes, the procedure commissioned on its breakaway and opening
+/// torques, else `None`.
 pub fn accept(
     trace: &Trace,
     config: Config,
@@ -51,8 +54,9 @@ pub fn accept(
     start_s: f64,
 ) -> Result<Option<TestConfig>, String> {
     let r = run_functional_test(trace, config, procedure, start_s)?;
-    Ok((r.result == TestResult::Pass)
-        .then(|| procedure.commissioned(r.breakaway_torque_nm.to_num())))
+    Ok((r.result == TestResult::Pass).then(|| {
+        procedure.commissioned(r.breakaway_torque_nm.to_num(), r.opening_torque_nm.to_num())
+    }))
 }
 
 /// A fault of `kind` and `severity` present from the start.

@@ -27,6 +27,7 @@ pub fn decode_tick(chunk: &[u8]) -> Option<(Inputs, bool)> {
         motor_counter: u32::from_le_bytes([b[2], b[3], b[4], b[5]]),
         output_counter: u32::from_le_bytes([b[6], b[7], b[8], b[9]]),
         drive_commanded: ctrl & 1 != 0,
+        current_command_code: None,
         ticks_elapsed: late,
     };
     Some((inputs, ctrl & 2 != 0))

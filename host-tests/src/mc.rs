@@ -14,7 +14,9 @@
 //! manifests ([`crate::accuracy::manifest_time`]). A nominal run with any flag is a false
 //! alarm. Runs are spread over the machine's cores.
 
-use crate::accuracy::{compare, detection_latency_s, manifest_time, run_monitor, scene_trace};
+use crate::accuracy::{
+    compare, detection_latency_s, manifest_time, run_monitor, run_monitor_with, scene_trace,
+};
 use crate::dormant::{functional_test_after, Verdict};
 use crate::family::Family;
 use noback::mechanism::Mechanism;
@@ -58,12 +60,16 @@ pub struct Outcome {
     pub fault: Option<FaultKind>,
     /// Detection latency (s), if detected at all after manifesting.
     pub latency_s: Option<f64>,
+    /// The same with the drive's current command in the monitor's inputs.
+    pub latency_with_command_s: Option<f64>,
     /// Whether the fault manifested within the scene.
     pub manifested: bool,
     /// Where the fault fell, for reading the misses (`None` in a nominal run).
     pub context: Option<Context>,
     /// Flags raised before the fault's onset (all flags in a nominal run).
     pub false_flags: usize,
+    /// The same with the drive's current command in the monitor's inputs.
+    pub false_flags_with_command: usize,
     /// The twin failed to run this draw (reported, never silently dropped).
     pub error: Option<String>,
     /// A nominal draw whose plant does not move its output while driven ([`not_driven`]):
@@ -75,6 +81,22 @@ pub struct Outcome {
 }
 
 impl Outcome {
+    /// A run of `fault` (nominal: `None`) that raised nothing and found nothing.
+    pub fn quiet(fault: Option<FaultKind>) -> Outcome {
+        Outcome {
+            fault,
+            latency_s: None,
+            latency_with_command_s: None,
+            manifested: false,
+            context: None,
+            false_flags: 0,
+            false_flags_with_command: 0,
+            error: None,
+            not_driven: false,
+            test: None,
+        }
+    }
+
     /// A nominal run the false-alarm rate counts: the twin ran it and its plant was driven.
     pub fn counts_as_nominal(&self) -> bool {
         self.fault.is_none() && self.error.is_none() && !self.not_driven
@@ -286,12 +308,11 @@ pub fn mirror(trace: &mut Trace, adc_bits: u8, motor_bits: u8, output_bits: u8) 
     let adc_full = (1_u32 << adc_bits) - 1;
     let motor_mask = (1_u64 << motor_bits) - 1;
     let out_mask = (1_u64 << output_bits) - 1;
+    // Offset binary about mid-scale: code c ↦ 2^bits − c, clamped to the converter.
+    let negate = |c: u16| (adc_full + 1).saturating_sub(u32::from(c)).min(adc_full) as u16;
     for r in &mut trace.rows {
-        // Offset binary about mid-scale: code c ↦ 2^bits − c, clamped to the converter.
-        let code = (adc_full + 1)
-            .saturating_sub(u32::from(r.current_code))
-            .min(adc_full);
-        r.current_code = code as u16;
+        r.current_code = negate(r.current_code);
+        r.current_command_code = r.current_command_code.map(negate);
         r.motor_count = ((motor_mask + 1 - u64::from(r.motor_count)) & motor_mask) as u32;
         r.output_count = ((out_mask + 1 - u64::from(r.output_count)) & out_mask) as u32;
     }
@@ -386,14 +407,8 @@ pub const TEST_EVERY: u64 = 10;
 pub fn evaluate(d: &Draw, campaign: &Campaign) -> Outcome {
     let fault = d.scene.faults.first().copied();
     let fail = |e: String| Outcome {
-        fault: fault.map(|f| f.kind),
-        latency_s: None,
-        manifested: false,
-        context: None,
-        false_flags: 0,
         error: Some(e),
-        not_driven: false,
-        test: None,
+        ..Outcome::quiet(fault.map(|f| f.kind))
     };
     let trace = match draw_trace_after(d, campaign.pre_roll_s) {
         Ok(trace) => trace,
@@ -406,6 +421,10 @@ pub fn evaluate(d: &Draw, campaign: &Campaign) -> Outcome {
         Err(e) => return fail(e),
     };
     let acc = compare(&trace, &estimates);
+    let with_command = match run_monitor_with(&trace, campaign.config, true) {
+        Ok(e) => compare(&trace, &e),
+        Err(e) => return fail(e),
+    };
     let onset = fault.map_or(f64::INFINITY, |f| f.at_s);
     let manifested = fault.is_some_and(|f| manifest_time(&f, &trace).is_some());
     let not_driven = fault.is_none() && not_driven(&trace);
@@ -426,9 +445,11 @@ pub fn evaluate(d: &Draw, campaign: &Campaign) -> Outcome {
     Outcome {
         fault: fault.map(|f| f.kind),
         latency_s: fault.and_then(|f| detection_latency_s(&f, &trace, &acc)),
+        latency_with_command_s: fault.and_then(|f| detection_latency_s(&f, &trace, &with_command)),
         manifested,
         context: fault.map(|f| Context::of(f.at_s, &trace, d.scene.kind, &campaign.config)),
         false_flags: acc.flags.iter().filter(|f| f.t_s < onset).count(),
+        false_flags_with_command: with_command.flags.iter().filter(|f| f.t_s < onset).count(),
         error: None,
         not_driven,
         test,

@@ -1,7 +1,8 @@
 //! The commanded functional test (issue 17) on the twin's `functional_test` scene: a healthy
 //! brake passes against the design's expectation; a unit commissioned on its own healthy test
-//! fails once its spring is half gone; a partial ramp jam fails even uncommissioned; the paper
-//! reading refuses the scene.
+//! fails once its spring is half gone, passes at a load 5 % off (the opening takes it out) and
+//! fails when its current sensor reads half; a partial ramp jam fails even uncommissioned; the
+//! paper reading refuses the scene.
 
 use host_tests::accuracy::{run_functional_test, scene_trace};
 use host_tests::dormant;
@@ -12,22 +13,39 @@ use noback_twin::fault::{Fault, FaultKind};
 use noback_twin::reading::Reading;
 use noback_twin::scene::{Scene, SceneKind};
 
-fn test_scene(fault: Option<(FaultKind, f64)>) -> Scene {
+fn test_scene(fault: Option<(FaultKind, f64)>, load_scale: f64) -> Scene {
     let base = Scene::builtin(SceneKind::FunctionalTest, Reading::Physical);
     let faults: Vec<Fault> = fault
         .map(|(k, s)| dormant::from_start(k, s))
         .into_iter()
         .collect();
-    dormant::test_scene(&base, base.load_torque_nm, &faults)
+    dormant::test_scene(&base, base.load_torque_nm * load_scale, &faults)
 }
 
 fn report(
     fault: Option<(FaultKind, f64)>,
     test: &TestConfig,
 ) -> noback::monitor::functional_test::TestReport {
-    let s = test_scene(fault);
+    report_at(fault, test, 1.0)
+}
+
+fn report_at(
+    fault: Option<(FaultKind, f64)>,
+    test: &TestConfig,
+    load_scale: f64,
+) -> noback::monitor::functional_test::TestReport {
+    let s = test_scene(fault, load_scale);
     let trace = scene_trace(&s).unwrap();
     run_functional_test(&trace, Config::default(), test, s.test.start_s).unwrap()
+}
+
+/// The procedure commissioned on the healthy unit's own acceptance test.
+fn commissioned_on_its_healthy_test() -> TestConfig {
+    let accepted = report(None, &TestConfig::DEFAULT);
+    TestConfig::DEFAULT.commissioned(
+        accepted.breakaway_torque_nm.to_num(),
+        accepted.opening_torque_nm.to_num(),
+    )
 }
 
 #[test]
@@ -40,14 +58,45 @@ fn a_healthy_brake_passes_at_its_design_capacity() {
 
 #[test]
 fn a_commissioned_unit_fails_with_half_its_spring() {
-    let accepted = report(None, &TestConfig::DEFAULT);
-    let test = TestConfig::DEFAULT.commissioned(accepted.breakaway_torque_nm.to_num());
+    let test = commissioned_on_its_healthy_test();
     assert_eq!(report(None, &test).result, TestResult::Pass);
     let r = report(Some((FaultKind::SpringBroken, 0.5)), &test);
     assert_eq!(r.result, TestResult::Fail, "{r:?}");
     // Uncommissioned, the same unit passes: the design's spread hides a spring half gone.
     let r = report(Some((FaultKind::SpringBroken, 0.5)), &TestConfig::DEFAULT);
     assert_eq!(r.result, TestResult::Pass, "{r:?}");
+}
+
+#[test]
+fn the_opening_takes_a_load_error_out_and_catches_a_sensor_reading_low() {
+    let test = commissioned_on_its_healthy_test();
+    let alone = TestConfig {
+        expected_opening_nm: None,
+        ..test
+    };
+    for scale in [0.95, 1.05] {
+        let r = report_at(None, &test, scale);
+        let (margin, load) = (r.margin.to_num::<f64>(), r.load_nm.to_num::<f64>());
+        assert_eq!(r.result, TestResult::Pass, "load ×{scale}: {r:?}");
+        assert!(
+            (margin - 1.0).abs() < 0.01,
+            "load ×{scale}: margin {margin}"
+        );
+        assert!(
+            (load / (20.3 * scale) - 1.0).abs() < 0.01,
+            "load ×{scale}: {load}"
+        );
+        // The breakaway alone reads the load's 5 % as a capacity change of about 4 %.
+        let m = report_at(None, &alone, scale).margin.to_num::<f64>();
+        assert!((m - 1.0).abs() > 0.02, "load ×{scale}: breakaway alone {m}");
+    }
+    // A quarter of the gain lost raises no alarm; the load both readings imply is 25 % low.
+    let r = report(Some((FaultKind::CurrentOpen, 0.25)), &test);
+    assert_eq!(r.result, TestResult::Fail, "{r:?}");
+    assert!(r.load_nm.to_num::<f64>() < 0.85 * 20.3, "{r:?}");
+    // Half of it: an alarm on the way aborts the test (found either way).
+    let r = report(Some((FaultKind::CurrentOpen, 0.5)), &test);
+    assert_ne!(r.result, TestResult::Pass, "{r:?}");
 }
 
 #[test]
@@ -75,6 +124,14 @@ fn settings_that_cannot_test_are_refused() {
         },
         TestConfig {
             expected_breakaway_nm: Some(f64::NAN),
+            ..TestConfig::DEFAULT
+        },
+        TestConfig {
+            expected_opening_nm: Some(24.0),
+            ..TestConfig::DEFAULT
+        },
+        TestConfig {
+            open_s: 0.0,
             ..TestConfig::DEFAULT
         },
     ] {

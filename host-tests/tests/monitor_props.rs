@@ -79,6 +79,7 @@ struct Tick {
     output: u32,
     drive: bool,
     late: u8,
+    command: Option<u16>,
 }
 
 fn tick() -> impl Strategy<Value = Tick> {
@@ -88,13 +89,19 @@ fn tick() -> impl Strategy<Value = Tick> {
         prop_oneof![any::<u32>(), 0_u32..16_384, 16_370_u32..16_400],
         any::<bool>(),
         prop_oneof![8 => Just(1_u8), 1 => any::<u8>()],
+        prop_oneof![
+            Just(None),
+            (1500_u16..2600).prop_map(Some),
+            any::<u16>().prop_map(Some)
+        ],
     )
-        .prop_map(|(code, motor, output, drive, late)| Tick {
+        .prop_map(|(code, motor, output, drive, late, command)| Tick {
             code,
             motor,
             output,
             drive,
             late,
+            command,
         })
 }
 
@@ -158,6 +165,7 @@ proptest! {
                 motor_counter: t.motor,
                 output_counter: t.output,
                 drive_commanded: t.drive,
+                current_command_code: t.command,
                 ticks_elapsed: t.late,
             };
             let e = m.step(&inputs);
@@ -186,6 +194,7 @@ proptest! {
                     motor_counter: t.motor,
                     output_counter: t.output,
                     drive_commanded: t.drive,
+                    current_command_code: t.command,
                     ticks_elapsed: t.late,
                 });
                 words.push(e.to_words());

@@ -24,6 +24,7 @@ mod target {
                 motor_counter: black_box(0),
                 output_counter: black_box(0),
                 drive_commanded: black_box(false),
+                current_command_code: black_box(Some(0)),
                 ticks_elapsed: black_box(1),
             }))
         }

@@ -9,13 +9,16 @@
 //! | common slip | `brake_slip` | slow lane, `Checks`, drive off, held | `hold.rs`, `slip.rs` |
 //! | drag, steps of the drive's work | `brake_drag`, `sensor_fault` | slow lane, `Checks`, drive on | `drive.rs` |
 //! | dead current reading | `sensor_fault` | window lane, drive on | `dead_current.rs` |
+//! | reading against the drive's command | `sensor_fault` | window lane, drive on, command given | `current_command.rs` |
 
+mod current_command;
 mod dead_current;
 mod drive;
 mod envelope;
 mod hold;
 mod slip;
 
+pub(crate) use current_command::CommandSettings;
 pub(crate) use dead_current::DeadCurrentSettings;
 pub(crate) use drive::DriveSettings;
 pub(crate) use envelope::EnvelopeSettings;
@@ -31,6 +34,7 @@ use super::schedule::{Slot, SLOW};
 use super::sense::Sensed;
 use super::{Flags, Scene};
 use crate::fx::Q16;
+use current_command::CommandCheck;
 use dead_current::DeadCurrent;
 use drive::{DriveChecks, DriveTick};
 pub(crate) use envelope::BrakingTick;
@@ -49,6 +53,7 @@ pub(crate) struct CheckSettings {
     pub hold: HoldSettings,
     pub drive: DriveSettings,
     pub dead_current: DeadCurrentSettings,
+    pub command: CommandSettings,
 }
 
 impl CheckSettings {
@@ -67,6 +72,7 @@ impl CheckSettings {
             hold: HoldSettings::new(c)?,
             drive: DriveSettings::new(c, pack, r)?,
             dead_current: DeadCurrentSettings::new(c, r)?,
+            command: CommandSettings::new(c)?,
         })
     }
 }
@@ -90,6 +96,7 @@ pub(crate) struct Checks {
     hold: HoldChecks,
     drive: DriveChecks,
     dead_current: DeadCurrent,
+    command: CommandCheck,
 }
 
 impl Checks {
@@ -100,6 +107,7 @@ impl Checks {
             hold: HoldChecks::default(),
             drive: DriveChecks::default(),
             dead_current: DeadCurrent::default(),
+            command: CommandCheck::default(),
         }
     }
 
@@ -128,6 +136,7 @@ impl Checks {
             }
             self.hold.disarm_slip();
             self.dead_current.disarm(x.out);
+            self.command.disarm();
         }
     }
 
@@ -232,6 +241,13 @@ impl Checks {
         {
             raised.sensor_fault = true;
             self.drive.suspect_current();
+        }
+        // The reading against the drive's own command, when the inputs carry it.
+        if let (true, Slot::DeadCurrent, Some(code)) = (drive, i.slot, x.command_code) {
+            if self.command.window(&k.command, x.current, code) {
+                raised.sensor_fault = true;
+                self.drive.suspect_current();
+            }
         }
         (raised, gave_way)
     }

@@ -153,6 +153,12 @@ pub struct Thresholds {
     /// The output counts as turning for the dead-reading check above this mean speed over the
     /// block (rad/s).
     pub dead_current_speed_rad_s: f64,
+    /// How far the current reading may lie from the drive's own command, as a share of the
+    /// command, summed over a block of 12.8 ms (`sensor_fault`; `checks/current_command.rs`);
+    /// runs only on inputs that carry the command; 0 turns it off.
+    pub command_gain_tolerance: f64,
+    /// Smallest commanded current (A, magnitude) the command check sums.
+    pub command_floor_a: f64,
     /// Rate at which the pack-health estimate may move (1/s, sign-LMS step).
     pub health_rate_per_s: f64,
     /// Time over which an impact in the lost motion may reverse the output speed before the
@@ -199,6 +205,8 @@ impl Thresholds {
         adc_rail_time_s: 0.01, // overrunning chatter stalls the motor at the current limit ≈ 3 ms
         dead_current_nm: 0.0,  // off: the paper reading closes on almost no drive torque
         dead_current_speed_rad_s: 2.0,
+        command_gain_tolerance: 0.3,
+        command_floor_a: 2.5,
         health_rate_per_s: 25.0,
         impact_time_s: 0.01,
         impact_window_s: 0.0016,

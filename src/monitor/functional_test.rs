@@ -1,17 +1,23 @@
-//! The commanded functional test (the ground crew's no-back check): at rest under a known
-//! load, the drive pushes along the load with a torque that rises at a set rate; the pack's
-//! self-locking margin sets the torque at which the input ramp relieves it enough to slip.
+//! The commanded functional test (the ground crew's no-back check). The drive first opens the
+//! door against its load for `open_s` (the monitor averages the drive torque over the second
+//! half), slows the door to rest and lets the brake take the load (`settle_s`), then pushes
+//! along the load with a torque
+//! that rises at a set rate; the pack's self-locking margin sets the torque at which the input
+//! ramp relieves it enough to slip.
 //!
 //! With `g = μ_s·c·k` (capacity per N·m of load through the ramps) and `C(L) = C₀ + g·L` the
 //! holding capacity, the pack slips once `C(L) − g·T < L + T`: the breakaway torque is
-//! `T_b = (C(L) − L)/(1 + g)`, so the measured capacity is `Ĉ = L + (1 + g)·T_b`. The test
-//! passes when `Ĉ` lies within `min_margin … max_margin` of the expected capacity (the
-//! design's, or the unit's own from its acceptance test) and the output broke away before the
-//! torque limit.
+//! `T_b = (C(L) − L)/(1 + g)`, so the capacity from the breakaway alone is `Ĉ = L + (1 + g)·T_b`.
+//! Against the unit's own acceptance test (`T_b⁰`, `T_o⁰`) the opening torque `T_o = L + d·C₀`
+//! takes the load's uncertainty out: `Ĉ = C⁰ + k_b·(T_b − T_b⁰) − k_o·(T_o − T_o⁰)`. The test
+//! passes when `Ĉ` lies within `min_margin … max_margin` of the expected capacity (the design's,
+//! or the unit's own), the load both readings imply lies within `load_tolerance` of the set one,
+//! and the output broke away before the torque limit.
 //!
 //! | quantity | format | range | resolution |
 //! |---|---|---|---|
-//! | torques, capacities | [`Q16`] N·m, saturating | ±32 768 | 1.5e-5 N·m |
+//! | torques, capacities, `k_b`, `k_o` | [`Q16`] N·m, saturating | ±32 768 | 1.5e-5 N·m |
+//! | opening torque sum | `i64` Q16 bits, saturating | ±2^47 N·m | 1.5e-5 N·m |
 //! | output travel | `i32` counts, saturating sum of wrapping deltas | ±2^31 | 1 count |
 //! | margin | [`Q16`], capacity over expected | 0 … 32 768 | 1.5e-5 |
 
@@ -34,38 +40,56 @@ pub struct TestConfig {
     pub torque_rate_nm_s: f64,
     /// The drive's torque limit (N·m): no breakaway below it fails the test.
     pub max_torque_nm: f64,
+    /// The opening against the load before the push (s); the second half is measured.
+    pub open_s: f64,
+    /// Between the opening and the push (s): the drive slows the door to rest and lets go, the
+    /// brake takes the load.
+    pub settle_s: f64,
     /// Output travel that counts as breakaway (rad).
     pub breakaway_rad: f64,
     /// The expected breakaway torque at `load_nm` (N·m): `None` = the design's,
     /// `(C(L) − L)/(1 + g)` from the configuration's mechanism and `capacity_mu`.
     pub expected_breakaway_nm: Option<f64>,
+    /// The unit's opening torque at its acceptance test (N·m): with `expected_breakaway_nm`, the
+    /// capacity comes from both readings; `None` = from the breakaway alone.
+    pub expected_opening_nm: Option<f64>,
     /// Lowest measured capacity, as a share of the expected, that passes.
     pub min_margin: f64,
     /// Highest that passes: above it the pack drags (a clamp the ramps did not make).
     pub max_margin: f64,
+    /// Commissioned on both readings: how far the load they imply may lie from `load_nm`
+    /// (fraction) — beyond it the current reads wrong (a sensor's gain) or the load is not set.
+    pub load_tolerance: f64,
     /// Corner frequency of the drive-torque filter (Hz): current noise out, ramp lag small.
     pub torque_filter_hz: f64,
 }
 
 impl TestConfig {
-    /// 20 N·m/s to 40 N·m under the paper's 20.3 N·m, breakaway at 2 mrad; against the design's
-    /// breakaway, pass at [`UNCOMMISSIONED_MIN_MARGIN`].
+    /// Open for 0.5 s, settle 0.3 s, push at 20 N·m/s to 40 N·m under the paper's 20.3 N·m,
+    /// breakaway at 2 mrad; against the design's breakaway, the band
+    /// [`UNCOMMISSIONED_MIN_MARGIN`] … [`UNCOMMISSIONED_MAX_MARGIN`].
     pub const DEFAULT: TestConfig = TestConfig {
         load_nm: 20.3,
         torque_rate_nm_s: 20.0,
         max_torque_nm: 40.0,
+        open_s: 0.5,
+        settle_s: 0.3,
         breakaway_rad: 2e-3,
         expected_breakaway_nm: None,
+        expected_opening_nm: None,
         min_margin: UNCOMMISSIONED_MIN_MARGIN,
         max_margin: UNCOMMISSIONED_MAX_MARGIN,
+        load_tolerance: 0.15,
         torque_filter_hz: 50.0,
     };
 
-    /// This procedure on a unit whose acceptance test under it broke away at `breakaway_nm`:
-    /// pass within [`COMMISSIONED_MIN_MARGIN`] … [`COMMISSIONED_MAX_MARGIN`] of that capacity.
-    pub fn commissioned(self, breakaway_nm: f64) -> TestConfig {
+    /// This procedure on a unit whose acceptance test under it opened at `opening_nm` and broke
+    /// away at `breakaway_nm`: pass within [`COMMISSIONED_MIN_MARGIN`] …
+    /// [`COMMISSIONED_MAX_MARGIN`] of that capacity.
+    pub fn commissioned(self, breakaway_nm: f64, opening_nm: f64) -> TestConfig {
         TestConfig {
             expected_breakaway_nm: Some(breakaway_nm),
+            expected_opening_nm: Some(opening_nm),
             min_margin: COMMISSIONED_MIN_MARGIN,
             max_margin: COMMISSIONED_MAX_MARGIN,
             ..self
@@ -80,7 +104,7 @@ pub const UNCOMMISSIONED_MIN_MARGIN: f64 = 0.80;
 /// Upper end of the uncommissioned band.
 pub const UNCOMMISSIONED_MAX_MARGIN: f64 = 1.25;
 /// Band against the unit's own acceptance capacity: outside the spread of a healthy unit's
-/// re-tests (load within ±5 %, fresh noise: 0.97…1.03 on seed 4242).
+/// re-tests (load within ±5 %, fresh noise; docs/functional-test.md).
 pub const COMMISSIONED_MIN_MARGIN: f64 = 0.95;
 /// Upper end of the commissioned band.
 pub const COMMISSIONED_MAX_MARGIN: f64 = 1.05;
@@ -99,11 +123,35 @@ pub struct TestSettings {
     expected_capacity: Q16,
     min_capacity: Q16,
     max_capacity: Q16,
+    /// The acceptance test's readings and their weights, when commissioned on both.
+    acceptance: Option<Acceptance>,
+    /// Ticks from the request: the opening's measured half starts, the opening ends, the push
+    /// starts.
+    measure_from: u32,
+    open_ticks: u32,
+    push_from: u32,
     /// Ticks of the ramp until the torque limit, plus a settling allowance.
     limit_ticks: u32,
     breakaway_counts: i32,
     out_bits: u8,
     alpha: Gain,
+}
+
+/// A unit's acceptance readings and `ΔĈ = k_b·ΔT_b − k_o·ΔT_o`'s weights.
+#[cfg_attr(
+    feature = "config-block",
+    derive(serde::Serialize, serde::Deserialize, Hash)
+)]
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct Acceptance {
+    breakaway: Q16,
+    opening: Q16,
+    k_b: Q16,
+    k_o: Q16,
+    /// `d`: the opening torque per N·m of `C₀`.
+    drag: Q16,
+    /// Largest `|L̂ − L|` that passes (N·m).
+    load_error: Q16,
 }
 
 impl TestSettings {
@@ -125,6 +173,36 @@ impl TestSettings {
         };
         require(expected_b > 0.0, "functional_test.expected_breakaway_nm")?;
         let expected = l + (1.0 + g) * expected_b;
+        // T_b = p·L + q·C₀ and T_o = L + d·C₀ (d: the pack's drag per C₀ while driving).
+        let drag = m.pack_torque_per_newton_m(finite(m.mu_dynamic, "mechanism.mu_dynamic")?);
+        let d = drag / per_n / (1.0 + drag * m.ramp_factor_per_m());
+        let (p, q) = ((g - 1.0) / (1.0 + g), 1.0 / (1.0 + g));
+        require(q - p * d > 0.05, "mechanism.mu_dynamic")?;
+        let acceptance = match (t.expected_breakaway_nm, t.expected_opening_nm) {
+            (Some(b), Some(o)) => Some(Acceptance {
+                breakaway: q16(b, "functional_test.expected_breakaway_nm")?,
+                opening: q16(
+                    positive(o, "functional_test.expected_opening_nm")?,
+                    "functional_test.expected_opening_nm",
+                )?,
+                k_b: q16(1.0 / (q - p * d), "mechanism.mu_dynamic")?,
+                k_o: q16(p / (q - p * d), "mechanism.mu_dynamic")?,
+                drag: q16(d, "mechanism.mu_dynamic")?,
+                load_error: q16(
+                    l * positive(t.load_tolerance, "functional_test.load_tolerance")?,
+                    "functional_test.load_tolerance",
+                )?,
+            }),
+            (None, Some(_)) => {
+                return Err(ConfigError::OutOfRange {
+                    parameter: "functional_test.expected_opening_nm",
+                })
+            }
+            _ => None,
+        };
+        let open_ticks = ticks(t.open_s, tick_hz(c)?, "functional_test.open_s")?;
+        let push_from =
+            open_ticks.saturating_add(ticks(t.settle_s, tick_hz(c)?, "functional_test.settle_s")?);
         let margin = positive(t.min_margin, "functional_test.min_margin")?;
         require(margin <= 1.0, "functional_test.min_margin")?;
         let top = finite(t.max_margin, "functional_test.max_margin")?;
@@ -135,7 +213,7 @@ impl TestSettings {
             / c.sensors.output_rad_per_count();
         require(counts < 1e6, "functional_test.breakaway_rad")?;
         let hz = positive(t.torque_filter_hz, "functional_test.torque_filter_hz")?;
-        let tick_hz = positive(c.tick_hz, "tick_hz")?;
+        let tick_hz = tick_hz(c)?;
         Ok(TestSettings {
             sign: if load > 0.0 { 1 } else { -1 },
             load: q16(l, "functional_test.load_nm")?,
@@ -143,6 +221,10 @@ impl TestSettings {
             expected_capacity: q16(expected, "functional_test.expected_breakaway_nm")?,
             min_capacity: q16(expected * margin, "functional_test.min_margin")?,
             max_capacity: q16(expected * top, "functional_test.max_margin")?,
+            acceptance,
+            measure_from: open_ticks / 2,
+            open_ticks,
+            push_from,
             limit_ticks: ticks(
                 max / rate + 5.0 / hz,
                 tick_hz,
@@ -154,6 +236,11 @@ impl TestSettings {
             alpha: filter_gain(hz, tick_hz, EVERY_TICK, "functional_test.torque_filter_hz")?,
         })
     }
+}
+
+/// The monitor's tick rate, checked.
+fn tick_hz(c: &Config) -> Result<f64, ConfigError> {
+    positive(c.tick_hz, "tick_hz")
 }
 
 /// Where the test stands.
@@ -183,6 +270,11 @@ pub enum TestResult {
 pub struct TestReport {
     /// Result.
     pub result: TestResult,
+    /// Mean drive torque against the load over the opening's measured half (N·m).
+    pub opening_torque_nm: Q16,
+    /// The load during the test (N·m): implied by both readings when commissioned on both
+    /// (`L + ΔT_o − d·ΔC₀`), else the configured one.
+    pub load_nm: Q16,
     /// Largest filtered drive torque along the load before breakaway (N·m).
     pub breakaway_torque_nm: Q16,
     /// Measured holding capacity at the test load `L + (1 + g)·T_b` (N·m).
@@ -198,8 +290,13 @@ pub struct TestReport {
 )]
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct FunctionalTest {
-    rest_count: Option<u32>,
+    /// Ticks since the request.
     ticks: u32,
+    /// Sum of the drive torque against the load over the opening's measured half (Q16 bits).
+    opening_sum: i64,
+    /// The output counter when the push started.
+    rest_count: Option<u32>,
+    /// Filtered drive torque along the load during the push.
     torque: Q16,
     report: TestReport,
 }
@@ -208,11 +305,14 @@ impl FunctionalTest {
     /// A test just requested (its report `Running` with zeros until stepped).
     pub fn new() -> FunctionalTest {
         FunctionalTest {
-            rest_count: None,
             ticks: 0,
+            opening_sum: 0,
+            rest_count: None,
             torque: Q16::ZERO,
             report: TestReport {
                 result: TestResult::Running,
+                opening_torque_nm: Q16::ZERO,
+                load_nm: Q16::ZERO,
                 breakaway_torque_nm: Q16::ZERO,
                 capacity_nm: Q16::ZERO,
                 margin: Q16::ZERO,
@@ -237,33 +337,72 @@ impl FunctionalTest {
             self.report.result = TestResult::Aborted;
             return self.report;
         }
-        let rest = *self.rest_count.get_or_insert(x.out);
-        let travel = s.sign * counter_delta(rest, x.out, s.out_bits);
         let along = if s.sign > 0 {
             drive_torque
         } else {
             drive_torque.saturating_neg()
         };
+        let tick = self.ticks;
+        self.ticks = self.ticks.saturating_add(x.n);
+        if tick < s.open_ticks {
+            if tick >= s.measure_from {
+                let against = i64::from(along.saturating_neg().to_bits());
+                self.opening_sum = self.opening_sum.saturating_add(against);
+            }
+            return self.report;
+        }
+        if tick < s.push_from {
+            let n = i64::from(s.open_ticks.saturating_sub(s.measure_from));
+            let mean = self.opening_sum.checked_div(n).unwrap_or(0);
+            self.report.opening_torque_nm = Q16::from_bits(i32::try_from(mean).unwrap_or(0));
+            return self.report;
+        }
+        let rest = *self.rest_count.get_or_insert(x.out);
+        let travel = s.sign * counter_delta(rest, x.out, s.out_bits);
         self.torque = lowpass(self.torque, along, s.alpha);
         self.report.breakaway_torque_nm = self.report.breakaway_torque_nm.max(self.torque);
-        self.ticks = self.ticks.saturating_add(x.n);
         if travel >= s.breakaway_counts {
-            let t_b = self.report.breakaway_torque_nm;
-            let capacity = s.load.saturating_add(s.lever.saturating_mul(t_b));
-            self.report.capacity_nm = capacity;
-            self.report.margin = capacity
-                .checked_div(s.expected_capacity)
-                .unwrap_or(Q16::ZERO);
-            let within = capacity >= s.min_capacity && capacity <= s.max_capacity;
-            self.report.result = if t_b > Q16::ZERO && within {
-                TestResult::Pass
-            } else {
-                TestResult::Fail
-            };
-        } else if self.ticks > s.limit_ticks {
+            self.decide(s);
+        } else if tick.saturating_sub(s.push_from) > s.limit_ticks {
             self.report.result = TestResult::Fail;
         }
         self.report
+    }
+
+    /// The capacity (and the load) from the breakaway and the opening when commissioned on
+    /// both, else from the breakaway alone, against the band.
+    fn decide(&mut self, s: &TestSettings) {
+        let r = &mut self.report;
+        let t_b = r.breakaway_torque_nm;
+        let (capacity, load_ok) = match s.acceptance {
+            Some(a) => {
+                let d_o = r.opening_torque_nm.saturating_sub(a.opening);
+                let d_c0 = a
+                    .k_b
+                    .saturating_mul(t_b.saturating_sub(a.breakaway))
+                    .saturating_sub(a.k_o.saturating_mul(d_o));
+                let d_l = d_o.saturating_sub(a.drag.saturating_mul(d_c0));
+                r.load_nm = s.load.saturating_add(d_l);
+                (
+                    s.expected_capacity.saturating_add(d_c0),
+                    d_l.saturating_abs() <= a.load_error,
+                )
+            }
+            None => {
+                r.load_nm = s.load;
+                (s.load.saturating_add(s.lever.saturating_mul(t_b)), true)
+            }
+        };
+        r.capacity_nm = capacity;
+        r.margin = capacity
+            .checked_div(s.expected_capacity)
+            .unwrap_or(Q16::ZERO);
+        let within = capacity >= s.min_capacity && capacity <= s.max_capacity;
+        r.result = if t_b > Q16::ZERO && within && load_ok {
+            TestResult::Pass
+        } else {
+            TestResult::Fail
+        };
     }
 
     /// The report so far.

@@ -24,6 +24,9 @@ pub struct Inputs {
     pub output_counter: u32,
     /// Whether the drive is commanded on.
     pub drive_commanded: bool,
+    /// The drive's current command as the ADC code an ideal sensor would read for it, if the
+    /// controller hands it on (`None`: the command check does not run).
+    pub current_command_code: Option<u16>,
     /// Ticks since the previous call: 1 when on time; `n > 1` means `n − 1` ticks were missed
     /// (raises `overrun`; the model is advanced by `n` ticks). 0 is treated as 1.
     pub ticks_elapsed: u8,
@@ -42,7 +45,16 @@ impl Inputs {
             motor_counter,
             output_counter,
             drive_commanded,
+            current_command_code: None,
             ticks_elapsed: 1,
+        }
+    }
+
+    /// These inputs with the drive's current command (an ADC code).
+    pub const fn with_command(self, current_command_code: Option<u16>) -> Inputs {
+        Inputs {
+            current_command_code,
+            ..self
         }
     }
 }

@@ -176,6 +176,8 @@ pub(crate) struct Sensed {
     pub out_ok: bool,
     /// Phase current (ADC counts about mid-scale).
     pub current: i32,
+    /// The drive's current command (ADC code), if the inputs carry it.
+    pub command_code: Option<u16>,
     /// An implausible reading this call.
     pub fault: bool,
     /// The part of `fault` known before the counters' steps (ADC code, rail, range).
@@ -195,6 +197,7 @@ impl Sensed {
         d_out: 0,
         out_ok: false,
         current: 0,
+        command_code: None,
         fault: false,
         early_fault: false,
     };
@@ -311,6 +314,7 @@ impl Sense {
             d_out,
             out_ok,
             current,
+            command_code: i.current_command_code,
             fault: early_fault || !out_ok || !motor_ok || stuck,
             early_fault,
         }

@@ -300,14 +300,16 @@ pub fn finish<P: embedded_hal::digital::OutputPin>(
             TestResult::Fail => defmt::intern!("fail"),
             TestResult::Aborted => defmt::intern!("aborted"),
         };
-        let (b, c) = (
+        let (o, b, c) = (
+            Decimal::from_q16(r.opening_torque_nm.to_bits(), 1000),
             Decimal::from_q16(r.breakaway_torque_nm.to_bits(), 1000),
             Decimal::from_q16(r.capacity_nm.to_bits(), 1000),
         );
         let m = Decimal::from_q16(r.margin.to_bits(), 1000);
         defmt::info!(
-            "functional-test result={=istr} breakaway_nm={=str}{=u32}.{=u32:03} capacity_nm={=str}{=u32}.{=u32:03} margin={=str}{=u32}.{=u32:03}",
+            "functional-test result={=istr} opening_nm={=str}{=u32}.{=u32:03} breakaway_nm={=str}{=u32}.{=u32:03} capacity_nm={=str}{=u32}.{=u32:03} margin={=str}{=u32}.{=u32:03}",
             result,
+            o.sign(), o.whole, o.frac,
             b.sign(), b.whole, b.frac,
             c.sign(), c.whole, c.frac,
             m.sign(), m.whole, m.frac

@@ -78,28 +78,37 @@ impl SceneKind {
 }
 
 /// The functional test's drive (scene kind `functional_test`): after `start_s` at rest under
-/// the load, the drive creeps along the load at `creep_speed_rad_s` with its torque limit rising
-/// at `torque_rate_nm_s` up to `torque_max_nm`; once the output has turned `abort_angle_rad`
-/// from where it was at `start_s`, it stops pushing and holds the door at rest.
+/// the load, the drive opens against the load at `creep_speed_rad_s` for `open_s`, slows the door
+/// to rest over the first third of `settle_s` and lets go for the rest of it (the brake takes
+/// the load), then creeps along the load with its torque limit
+/// rising at `torque_rate_nm_s` up to `torque_max_nm`; once the output has turned
+/// `abort_angle_rad` along the load from where the opening ended, it holds the door at rest.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct TestProfile {
     /// Rest before the ramp starts (s): the load settles on the brake.
     pub start_s: f64,
-    /// Input-shaft creep speed along the load (rad/s).
+    /// Input-shaft speed of the opening and of the push (rad/s).
     pub creep_speed_rad_s: f64,
+    /// Opening against the load (s).
+    pub open_s: f64,
+    /// Between the opening and the push (s): a third slowing to rest, the rest let go.
+    pub settle_s: f64,
     /// Rise rate of the drive's torque limit (N·m/s at the input shaft).
     pub torque_rate_nm_s: f64,
     /// Largest torque limit (N·m at the input shaft).
     pub torque_max_nm: f64,
-    /// Output travel from rest at which the drive stops pushing (rad).
+    /// Output travel from the opening's end at which the drive stops and holds (rad).
     pub abort_angle_rad: f64,
 }
 
-/// The default test: 0.2 s at rest, 1 rad/s creep, 20 N·m/s to 40 N·m (the motor's full
-/// scale is 40.5 N·m), stopped after 0.05 rad (2.9°) of output travel.
+/// The default test: 0.2 s at rest, 0.5 s opening at 1 rad/s, 0.3 s to rest, a 1 rad/s push
+/// at 20 N·m/s to 40 N·m (the motor's full scale is 40.5 N·m), stopped after 0.05 rad (2.9°)
+/// of output travel.
 pub const DEFAULT_TEST: TestProfile = TestProfile {
     start_s: 0.2,
     creep_speed_rad_s: 1.0,
+    open_s: 0.5,
+    settle_s: 0.3,
     torque_rate_nm_s: 20.0,
     torque_max_nm: 40.0,
     abort_angle_rad: 0.05,
@@ -151,6 +160,13 @@ pub struct Scene {
     pub test: TestProfile,
 }
 
+impl TestProfile {
+    /// When the push along the load starts (s).
+    pub fn push_s(&self) -> f64 {
+        self.start_s + self.open_s + self.settle_s
+    }
+}
+
 impl Scene {
     /// A built-in scene with the paper's conditions (§4): M = 20.3 N·m, 13.78 rad/s, drive cut
     /// at 0.2 s for the two braking cases, 3 s of continuous closing.
@@ -160,7 +176,7 @@ impl Scene {
             SceneKind::ContinuousClosing => (None, 3.0),
             SceneKind::Hold => (None, 0.5),
             SceneKind::Drive => (None, 0.5),
-            SceneKind::FunctionalTest => (None, 2.7),
+            SceneKind::FunctionalTest => (None, 3.5),
         };
         Scene {
             name: kind.name().to_string(),

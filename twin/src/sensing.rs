@@ -68,8 +68,8 @@ pub fn trace(
     let rows = samples
         .iter()
         .map(|s| {
-            let mut current = noise.current_gain * sensors.current_for_torque_a(s.drive_torque_nm)
-                + noise.current_offset_a;
+            let commanded = sensors.current_for_torque_a(s.drive_torque_nm);
+            let mut current = noise.current_gain * commanded + noise.current_offset_a;
             if noise.current_noise_a > 0.0 {
                 current += noise.current_noise_a * rng.normal();
             }
@@ -111,6 +111,8 @@ pub fn trace(
                 input_speed_rad_s: s.input_speed_rad_s,
                 output_angle_rad: s.output_angle_rad,
                 brake_state: s.brake_state,
+                // The drive's current loop closes on its own sensing: its command is the current.
+                current_command_code: Some(current_code(sensors, commanded)),
             }
         })
         .collect();

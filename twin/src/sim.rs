@@ -45,24 +45,39 @@ pub fn model_config(scene: &Scene) -> ModelConfig {
 }
 
 /// The drive a scene commands at time `t_s` (`on` = not yet cut): the scene's speed, and for
-/// the functional test its creep speed under the torque limit's ramp.
+/// the functional test its opening, its rest and its push under the torque limit's ramp.
 fn scene_drive(scene: &Scene, t_s: f64, on: bool) -> Drive {
     if scene.kind == SceneKind::FunctionalTest {
         let p = &scene.test;
-        if !on {
+        let t = t_s - p.start_s;
+        // Opening, then slowing to rest over the settle's first third: a speed reference.
+        let speed_ref = if t < p.open_s {
+            Some(-p.creep_speed_rad_s)
+        } else if t < p.open_s + p.settle_s / 3.0 {
+            Some(-p.creep_speed_rad_s * (1.0 - (t - p.open_s) * 3.0 / p.settle_s))
+        } else {
+            None
+        };
+        return match (on, t >= 0.0, speed_ref) {
             // Stopped at the abort angle: the drive holds the door at rest, at full torque.
-            return Drive {
+            (false, _, _) => Drive {
                 on: true,
                 speed_ref_rad_s: 0.0,
                 torque_limit_nm: None,
-            };
-        }
-        return Drive {
-            on,
-            speed_ref_rad_s: p.creep_speed_rad_s,
-            torque_limit_nm: Some(
-                (p.torque_rate_nm_s * (t_s - p.start_s)).clamp(0.0, p.torque_max_nm),
-            ),
+            },
+            (true, true, Some(w)) => Drive {
+                on: true,
+                speed_ref_rad_s: w,
+                torque_limit_nm: None,
+            },
+            // At rest (no torque until the push starts), then the push's rising limit.
+            _ => Drive {
+                on: true,
+                speed_ref_rad_s: p.creep_speed_rad_s,
+                torque_limit_nm: Some(
+                    (p.torque_rate_nm_s * (t_s - p.push_s())).clamp(0.0, p.torque_max_nm),
+                ),
+            },
         };
     }
     Drive {
@@ -153,7 +168,7 @@ pub fn run_model_with<M: TwinModel, I: SegmentSolver>(
             },
         )?;
         t = b;
-        if scene.kind == SceneKind::FunctionalTest && t >= scene.test.start_s {
+        if scene.kind == SceneKind::FunctionalTest && t >= scene.test.start_s + scene.test.open_s {
             let angle = samples.last().map_or(0.0, |s| s.output_angle_rad);
             let rest = *rest_angle.get_or_insert(angle);
             aborted |= (angle - rest).abs() >= scene.test.abort_angle_rad;

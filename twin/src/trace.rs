@@ -5,17 +5,20 @@
 //! ```text
 //! # noback-trace v1
 //! # sample_rate_hz=10000
-//! t_s,current_code,motor_count,output_count,drive_on,pressing_force_n,braking_torque_nm,output_speed_rad_s,input_speed_rad_s,output_angle_rad,brake_state
-//! 0.0000,2048,0,0,1,169.2,8.43,-13.78,-13.78,0,1
+//! t_s,current_code,motor_count,output_count,drive_on,pressing_force_n,braking_torque_nm,output_speed_rad_s,input_speed_rad_s,output_angle_rad,brake_state,current_command_code
+//! 0.0000,2048,0,0,1,169.2,8.43,-13.78,-13.78,0,1,2048
 //! ```
+//!
+//! The last column, the drive's current command, is optional: a trace without it (an ECU that
+//! does not log it) reads with `current_command_code = None`.
 
 use std::io::Write;
 
 /// The first line of every trace file.
 pub const HEADER: &str = "# noback-trace v1";
 
-/// The column names, in order.
-pub const COLUMNS: [&str; 11] = [
+/// The column names, in order; the last ([`COMMAND_COLUMN`]) may be absent.
+pub const COLUMNS: [&str; 12] = [
     "t_s",
     "current_code",
     "motor_count",
@@ -27,7 +30,12 @@ pub const COLUMNS: [&str; 11] = [
     "input_speed_rad_s",
     "output_angle_rad",
     "brake_state",
+    COMMAND_COLUMN,
 ];
+
+/// The optional last column: the drive's current command as the ADC code an ideal sensor would
+/// read for it (offset binary).
+pub const COMMAND_COLUMN: &str = "current_command_code";
 
 /// One row: the raw readings and the truth at one sample.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
@@ -54,6 +62,8 @@ pub struct TraceRow {
     pub output_angle_rad: f64,
     /// Truth: 0 released, 1 slipping, 2 locked.
     pub brake_state: u8,
+    /// The drive's current command (ADC code of an ideal sensor), if logged.
+    pub current_command_code: Option<u16>,
 }
 
 /// A whole trace.
@@ -111,13 +121,19 @@ fn parse_err(line: usize, column: usize, message: impl Into<String>) -> TraceErr
 }
 
 impl Trace {
-    /// Write the trace in the v1 CSV format.
+    /// Write the trace in the v1 CSV format (the command column when every row has one).
     pub fn write_to(&self, w: &mut dyn Write) -> Result<(), TraceError> {
+        let command = self.rows.iter().all(|r| r.current_command_code.is_some());
+        let columns = if command {
+            &COLUMNS[..]
+        } else {
+            &COLUMNS[..COLUMNS.len() - 1]
+        };
         writeln!(w, "{HEADER}")?;
         writeln!(w, "# sample_rate_hz={}", self.sample_rate_hz)?;
-        writeln!(w, "{}", COLUMNS.join(","))?;
+        writeln!(w, "{}", columns.join(","))?;
         for r in &self.rows {
-            writeln!(
+            write!(
                 w,
                 "{:.4},{},{},{},{},{:.3},{:.4},{:.6},{:.6},{:.7},{}",
                 r.t_s,
@@ -132,6 +148,10 @@ impl Trace {
                 r.output_angle_rad,
                 r.brake_state
             )?;
+            match r.current_command_code {
+                Some(c) if command => writeln!(w, ",{c}")?,
+                _ => writeln!(w)?,
+            }
         }
         Ok(())
     }
@@ -172,6 +192,7 @@ impl Trace {
             rows: Vec::new(),
         };
         let mut header_seen = false;
+        let mut with_command = false;
         let mut rate_line = None;
         let mut header_line = 1;
         for (n, line) in lines {
@@ -199,7 +220,9 @@ impl Trace {
             }
             if !header_seen {
                 let cols: Vec<&str> = line.split(',').collect();
-                if cols != COLUMNS {
+                with_command = cols.len() == COLUMNS.len();
+                let expected = &COLUMNS[..COLUMNS.len() - usize::from(!with_command)];
+                if cols != expected {
                     let col = cols
                         .iter()
                         .zip(COLUMNS.iter())
@@ -215,7 +238,7 @@ impl Trace {
                 header_line = n;
                 continue;
             }
-            let row = parse_row(n, line)?;
+            let row = parse_row(n, line, with_command)?;
             if let Some(last) = trace.rows.last() {
                 if row.t_s <= last.t_s {
                     return Err(parse_err(
@@ -253,13 +276,14 @@ impl Trace {
     }
 }
 
-fn parse_row(n: usize, line: &str) -> Result<TraceRow, TraceError> {
+fn parse_row(n: usize, line: &str, with_command: bool) -> Result<TraceRow, TraceError> {
     let f: Vec<&str> = line.split(',').collect();
-    if f.len() != COLUMNS.len() {
+    let fields = COLUMNS.len() - usize::from(!with_command);
+    if f.len() != fields {
         return Err(parse_err(
             n,
-            f.len().min(COLUMNS.len()) + 1,
-            format!("expected {} fields, found {}", COLUMNS.len(), f.len()),
+            f.len().min(fields) + 1,
+            format!("expected {fields} fields, found {}", f.len()),
         ));
     }
     let field = |i: usize| f.get(i).copied().unwrap_or("").trim();
@@ -294,9 +318,15 @@ fn parse_row(n: usize, line: &str) -> Result<TraceRow, TraceError> {
             )
         })
     };
-    let code = int(1)?;
-    let current_code =
-        u16::try_from(code).map_err(|_| parse_err(n, 2, "current code over 65535"))?;
+    let code16 = |i: usize| {
+        u16::try_from(int(i)?).map_err(|_| parse_err(n, i + 1, "current code over 65535"))
+    };
+    let current_code = code16(1)?;
+    let current_command_code = if with_command {
+        Some(code16(11)?)
+    } else {
+        None
+    };
     let drive = int(4)?;
     if drive > 1 {
         return Err(parse_err(n, 5, "drive_on must be 0 or 1"));
@@ -317,6 +347,7 @@ fn parse_row(n: usize, line: &str) -> Result<TraceRow, TraceError> {
         input_speed_rad_s: float(8)?,
         output_angle_rad: float(9)?,
         brake_state: state as u8,
+        current_command_code,
     })
 }
 
@@ -340,6 +371,7 @@ mod tests {
                     input_speed_rad_s: -13.78,
                     output_angle_rad: 0.0,
                     brake_state: 1,
+                    current_command_code: None,
                 },
                 TraceRow {
                     t_s: 0.0001,
@@ -362,6 +394,29 @@ mod tests {
         assert_eq!(back.rows[0].current_code, 2048);
         assert!((back.rows[0].pressing_force_n - 169.2).abs() < 1e-9);
         assert_eq!(back.sample_rate_hz, 10_000.0);
+        assert_eq!(back.rows[0].current_command_code, None);
+    }
+
+    #[test]
+    fn the_command_column_round_trips_when_every_row_has_it() {
+        let mut t = sample();
+        for (r, c) in t.rows.iter_mut().zip([2100, 1990]) {
+            r.current_command_code = Some(c);
+        }
+        let mut buf = Vec::new();
+        t.write_to(&mut buf).unwrap();
+        let text = String::from_utf8(buf).unwrap();
+        assert!(
+            text.contains(",brake_state,current_command_code\n"),
+            "{text}"
+        );
+        let back = Trace::parse(&text).unwrap();
+        assert_eq!(back.rows[1].current_command_code, Some(1990));
+        let missing = text.replace(",1990\n", "\n");
+        assert!(matches!(
+            Trace::parse(&missing),
+            Err(TraceError::Parse { line: 5, .. })
+        ));
     }
 
     #[test]
@@ -393,7 +448,7 @@ mod tests {
 
     #[test]
     fn a_trace_that_cannot_be_compared_is_refused_naming_why() {
-        let cols = COLUMNS.join(",");
+        let cols = COLUMNS[..COLUMNS.len() - 1].join(",");
         let row = |t: &str| format!("{t},2048,0,0,0,0,0,0,0,0,0\n");
         let text = |rate: &str, rows: &[&str]| {
             let body: String = rows.iter().map(|t| row(t)).collect();

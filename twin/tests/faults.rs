@@ -99,18 +99,31 @@ fn a_full_ramp_jam_lets_the_held_load_back_drive_and_a_partial_one_holds() {
     }
 }
 
-/// The functional test's drive: at rest until the ramp starts, then it pushes along the load
-/// until the output breaks away, and from the abort angle it holds the door at rest.
+/// The functional test's drive: at rest until the test starts, then it opens the door against
+/// the load (the drive carries the load), slows it to rest and lets go, pushes along the load
+/// until the output breaks away, and from the abort angle (from the opening's end) it holds
+/// the door at rest.
 #[test]
-fn the_functional_test_pushes_until_breakaway_and_stops_at_the_abort_angle() {
+fn the_functional_test_opens_then_pushes_until_breakaway_and_stops_at_the_abort_angle() {
     let s = Scene::builtin(SceneKind::FunctionalTest, Reading::Physical);
+    let p = s.test;
     let r = sim::run(&s).unwrap();
     let at = |t: f64| r.samples.iter().find(|x| x.t_s >= t).unwrap();
-    let rest = at(s.test.start_s).output_angle_rad;
-    assert!((at(0.15).output_angle_rad - rest).abs() < 1e-3);
+    let start = at(p.start_s).output_angle_rad;
+    assert!((at(0.15).output_angle_rad - start).abs() < 1e-3);
+    // Opening: against the load (negative) below the creep speed (the proportional servo's
+    // droop under the load), the drive carrying the load.
+    let opening = at(p.start_s + 0.8 * p.open_s);
+    let w = -opening.output_speed_rad_s / p.creep_speed_rad_s;
+    assert!((0.3..=1.0).contains(&w), "{opening:?}");
+    assert!(opening.drive_torque_nm < -s.load_torque_nm, "{opening:?}");
+    // At rest on the brake when the push starts.
+    let rest = at(p.push_s() - 1e-3);
+    assert!(rest.output_speed_rad_s.abs() < 0.05, "{rest:?}");
     let peak = r
         .samples
         .iter()
+        .filter(|x| x.t_s >= p.push_s())
         .map(|x| x.drive_torque_nm)
         .fold(0.0, f64::max);
     assert!((5.0..20.0).contains(&peak), "breakaway push {peak} N·m");
@@ -119,9 +132,9 @@ fn the_functional_test_pushes_until_breakaway_and_stops_at_the_abort_angle() {
         end.drive_on && end.output_speed_rad_s.abs() < 0.05,
         "{end:?}"
     );
-    let travel = end.output_angle_rad - rest;
+    let travel = end.output_angle_rad - at(p.start_s + p.open_s).output_angle_rad;
     assert!(
-        travel >= s.test.abort_angle_rad && travel < 2.0 * s.test.abort_angle_rad,
+        travel >= p.abort_angle_rad && travel < 2.0 * p.abort_angle_rad,
         "travel {travel} rad"
     );
 }

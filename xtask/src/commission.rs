@@ -80,14 +80,17 @@ pub fn main(a: &CommissionArgs) -> Result<i32, String> {
                 "the acceptance functional test did not pass: the unit is not healthy",
             ));
         };
-        // The file carries the breakaway to the millinewton-metre.
-        let b = t
-            .expected_breakaway_nm
-            .map_or(0.0, |b| (b * 1e3).round() / 1e3);
-        t.expected_breakaway_nm = Some(b);
+        // The file carries the acceptance readings to the millinewton-metre.
+        let mn = |x: Option<f64>| x.map(|v| (v * 1e3).round() / 1e3);
+        t.expected_breakaway_nm = mn(t.expected_breakaway_nm);
+        t.expected_opening_nm = mn(t.expected_opening_nm);
+        let (b, o) = (
+            t.expected_breakaway_nm.unwrap_or(0.0),
+            t.expected_opening_nm.unwrap_or(0.0),
+        );
         c.config.functional_test = t;
         test_note = format!(
-            ", functional test breakaway {b} N·m at {} N·m",
+            ", functional test breakaway {b} N·m, opening {o} N·m at {} N·m",
             procedure.load_nm
         );
     }

@@ -46,17 +46,23 @@ pub fn config_from_file(path: &std::path::Path) -> Result<Config, String> {
 }
 
 /// Entry.
-/// The functional test of a `functional_test` scene, requested when its ramp starts, with the
-/// scene's load and ramp and the expected breakaway of `config`'s design.
+/// The functional test of a `functional_test` scene, requested when its opening starts: a
+/// configuration file's procedure (a commissioned unit's acceptance readings), or the scene's.
 fn functional_test_json(
     trace: &noback_twin::trace::Trace,
     config: Config,
+    from_file: bool,
     scene: &Scene,
 ) -> Result<serde_json::Value, String> {
-    let test = host_tests::dormant::procedure_of(scene);
+    let test = if from_file {
+        config.functional_test
+    } else {
+        host_tests::dormant::procedure_of(scene)
+    };
     let r = run_functional_test(trace, config, &test, scene.test.start_s)?;
     Ok(json!({
         "result": format!("{:?}", r.result).to_lowercase(),
+        "opening_torque_nm": r.opening_torque_nm.to_num::<f64>(),
         "breakaway_torque_nm": r.breakaway_torque_nm.to_num::<f64>(),
         "capacity_nm": r.capacity_nm.to_num::<f64>(),
         "margin": r.margin.to_num::<f64>(),
@@ -85,7 +91,7 @@ pub fn main(a: &MonitorArgs) -> Result<i32, String> {
         .as_ref()
         .filter(|s| s.kind == SceneKind::FunctionalTest)
     {
-        Some(s) => Some(functional_test_json(&trace, config, s)?),
+        Some(s) => Some(functional_test_json(&trace, config, a.config.is_some(), s)?),
         None => None,
     };
 

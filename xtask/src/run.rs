@@ -400,12 +400,14 @@ pub fn replay_report_with(
             let num = |k: &str| field::<f64>(&line, k);
             let v = json!({
                 "result": result,
+                "opening_torque_nm": num("opening_nm")?,
                 "breakaway_torque_nm": num("breakaway_nm")?,
                 "capacity_nm": num("capacity_nm")?,
                 "margin": num("margin")?,
             });
             let milli = |q: noback::fx::Q16| (q.to_num::<f64>() * 1e3).round() / 1e3;
             let same = result == format!("{:?}", h.result).to_lowercase()
+                && (num("opening_nm")? - milli(h.opening_torque_nm)).abs() < 1.5e-3
                 && (num("breakaway_nm")? - milli(h.breakaway_torque_nm)).abs() < 1.5e-3
                 && (num("margin")? - milli(h.margin)).abs() < 1.5e-3;
             (v, same)

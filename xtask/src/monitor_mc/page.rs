@@ -107,12 +107,12 @@ pub fn table(r: &Value) -> String {
         r["twin_errors"].as_array().map_or(0, Vec::len),
         r["not_driven_runs"].as_u64().unwrap_or(0)
     );
-    let _ = writeln!(s, "| fault kind | runs | manifested | detected ≤ 50 ms | rate [95 % interval] | median latency (ms) | max latency (ms) | false alarms before onset | onset after settling: detected / manifested | rate there [95 % interval] |");
-    let _ = writeln!(s, "|---|---|---|---|---|---|---|---|---|---|");
+    let _ = writeln!(s, "| fault kind | runs | manifested | detected ≤ 50 ms | rate [95 % interval] | median latency (ms) | max latency (ms) | false alarms before onset | onset after settling: detected / manifested | rate there [95 % interval] | with the drive's current command: rate [95 % interval] |");
+    let _ = writeln!(s, "|---|---|---|---|---|---|---|---|---|---|---|");
     for row in r["fault_kinds"].as_array().into_iter().flatten() {
         let _ = writeln!(
             s,
-            "| {} | {} | {} | {} | {} | {} | {} | {} | {} / {} | {} |",
+            "| {} | {} | {} | {} | {} | {} | {} | {} | {} / {} | {} | {} |",
             row["kind"].as_str().unwrap_or(""),
             row["runs"],
             row["manifested"],
@@ -124,8 +124,16 @@ pub fn table(r: &Value) -> String {
             row["detected_after_settling"],
             row["manifested_after_settling"],
             fmt_rate(&row["detection_rate_after_settling"]),
+            fmt_rate(&row["detection_rate_with_command"]),
         );
     }
+    let _ = writeln!(
+        s,
+        "\nWith the drive's current command in the monitor's inputs (`Inputs::current_command_code`, \
+         docs/monitor-design.md), nominal runs with any flag: {} of {}.",
+        r["false_alarm_runs_with_command"],
+        r["nominal_runs"]
+    );
     let _ = writeln!(
         s,
         "\nMisses by where the fault fell (missed / manifested; the first that applies):\n"

@@ -37,8 +37,13 @@ pub struct FaultRun {
     pub index: u64,
     pub manifested: bool,
     pub latency_s: Option<f64>,
+    /// With the drive's current command in the monitor's inputs.
+    #[serde(default)]
+    pub latency_with_command_s: Option<f64>,
     pub context: Option<String>,
     pub false_flags: usize,
+    #[serde(default)]
+    pub false_flags_with_command: usize,
     pub error: Option<String>,
     /// The functional test after the run: `rejected`, `pass` or `fail`; absent if not run.
     #[serde(default, skip_serializing_if = "Option::is_none")]
@@ -65,6 +70,9 @@ pub struct Part {
     pub faults: [u64; 2],
     /// Nominal runs with any flag (not-driven runs apart).
     pub false_alarm_runs: Vec<u64>,
+    /// The same with the drive's current command in the monitor's inputs.
+    #[serde(default)]
+    pub false_alarm_runs_with_command: Vec<u64>,
     /// Nominal runs whose plant did not move its output while driven (`mc::not_driven`).
     #[serde(default)]
     pub not_driven_runs: Vec<u64>,
@@ -143,6 +151,9 @@ impl Part {
             nominal: [nominal.start, nominal.end],
             faults: [faults.start, faults.end],
             false_alarm_runs: nominal_where(|o| o.counts_as_nominal() && o.false_flags > 0),
+            false_alarm_runs_with_command: nominal_where(|o| {
+                o.counts_as_nominal() && o.false_flags_with_command > 0
+            }),
             not_driven_runs: nominal_where(|o| o.error.is_none() && o.not_driven),
             nominal_errors: nominal
                 .clone()
@@ -163,8 +174,10 @@ impl Part {
                     index,
                     manifested: o.manifested,
                     latency_s: o.latency_s,
+                    latency_with_command_s: o.latency_with_command_s,
                     context: o.context.map(|c| context_tag(c).into()),
                     false_flags: o.false_flags,
+                    false_flags_with_command: o.false_flags_with_command,
                     error: o.error.clone(),
                     test: o.test.map(|v| verdict_tag(v).into()),
                 })
@@ -191,9 +204,11 @@ fn outcome_of(r: &FaultRun) -> Result<Outcome, String> {
     Ok(Outcome {
         fault: Some(fault),
         latency_s: r.latency_s,
+        latency_with_command_s: r.latency_with_command_s,
         manifested: r.manifested,
         context,
         false_flags: r.false_flags,
+        false_flags_with_command: r.false_flags_with_command,
         error: r.error.clone(),
         not_driven: false,
         test: r.test.as_deref().map(verdict_of).transpose()?,
@@ -331,23 +346,14 @@ pub fn merge(parts: &[(String, Part)], prefix: bool) -> Result<(Campaign, Vec<Ou
     let mut ranges: Vec<_> = parts.iter().map(|(n, p)| (n.as_str(), p.faults)).collect();
     c.fault_runs = tile("fault", &mut ranges, c.fault_runs, prefix)?;
 
-    let mut nominal = vec![
-        Outcome {
-            fault: None,
-            latency_s: None,
-            manifested: false,
-            context: None,
-            false_flags: 0,
-            error: None,
-            not_driven: false,
-            test: None,
-        };
-        c.runs as usize
-    ];
+    let mut nominal = vec![Outcome::quiet(None); c.runs as usize];
     let mut faults: Vec<Option<Outcome>> = vec![None; FAULT_KINDS.len() * c.fault_runs as usize];
     for (name, p) in parts {
         for &i in &p.false_alarm_runs {
             nominal[i as usize].false_flags = 1;
+        }
+        for &i in &p.false_alarm_runs_with_command {
+            nominal[i as usize].false_flags_with_command = 1;
         }
         for &i in &p.not_driven_runs {
             nominal[i as usize].not_driven = true;

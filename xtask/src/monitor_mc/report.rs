@@ -47,6 +47,12 @@ fn detected(o: &Outcome) -> bool {
     o.latency_s.is_some_and(|l| l <= DETECTION_WINDOW_S)
 }
 
+/// [`detected`] with the drive's current command in the monitor's inputs.
+fn detected_with_command(o: &Outcome) -> bool {
+    o.latency_with_command_s
+        .is_some_and(|l| l <= DETECTION_WINDOW_S)
+}
+
 /// The report of a campaign whose outcomes are `outcomes` (nominal first, then each fault kind
 /// in [`FAULT_KINDS`] order, each by run index).
 pub fn build(meta: &Meta, outcomes: &[Outcome]) -> Result<Value, String> {
@@ -55,6 +61,10 @@ pub fn build(meta: &Meta, outcomes: &[Outcome]) -> Result<Value, String> {
     let nominal: Vec<&Outcome> = outcomes.iter().filter(|o| o.counts_as_nominal()).collect();
     let false_alarm_runs = nominal.iter().filter(|o| o.false_flags > 0).count();
     let false_alarm = rate(false_alarm_runs, nominal.len());
+    let false_alarm_runs_with_command = nominal
+        .iter()
+        .filter(|o| o.false_flags_with_command > 0)
+        .count();
     let per_hour = false_alarm["ci95"][1]
         .as_f64()
         .map(|hi| (hi * RUNS_PER_DOOR_CYCLE * DOOR_CYCLES_PER_FLIGHT_HOUR).min(1.0));
@@ -73,6 +83,10 @@ pub fn build(meta: &Meta, outcomes: &[Outcome]) -> Result<Value, String> {
             .collect();
         latencies.sort_by(f64::total_cmp);
         let hits = latencies.len();
+        let hits_with_command = manifested
+            .iter()
+            .filter(|o| detected_with_command(o))
+            .count();
         // No manifested run leaves the target unproven: it counts as not met, shown as "—".
         let detection = rate(hits, manifested.len());
         all_ok &= detection["rate"]
@@ -119,6 +133,8 @@ pub fn build(meta: &Meta, outcomes: &[Outcome]) -> Result<Value, String> {
             "manifested": manifested.len(),
             "detected_within_window": hits,
             "detection_rate": detection,
+            "detected_with_command": hits_with_command,
+            "detection_rate_with_command": rate(hits_with_command, manifested.len()),
             "manifested_after_settling": settled.len(),
             "detected_after_settling": hits_settled,
             "detection_rate_after_settling": rate(hits_settled, settled.len()),
@@ -139,6 +155,8 @@ pub fn build(meta: &Meta, outcomes: &[Outcome]) -> Result<Value, String> {
         "nominal_runs": nominal.len(),
         "false_alarm_runs": false_alarm_runs,
         "false_alarm_rate": false_alarm,
+        "false_alarm_runs_with_command": false_alarm_runs_with_command,
+        "false_alarm_rate_with_command": rate(false_alarm_runs_with_command, nominal.len()),
         "door_cycles_per_flight_hour": DOOR_CYCLES_PER_FLIGHT_HOUR,
         "runs_per_door_cycle": RUNS_PER_DOOR_CYCLE,
         "false_alarm_per_flight_hour_upper95": per_hour,

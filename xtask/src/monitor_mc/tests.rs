@@ -91,16 +91,7 @@ fn merge_refuses_parts_that_do_not_belong_together() {
         let outcomes: Vec<_> = (0..n)
             .map(|_| None)
             .chain((0..f).map(|i| Some(FAULT_KINDS[i / (f / FAULT_KINDS.len())])))
-            .map(|fault| host_tests::mc::Outcome {
-                fault,
-                latency_s: None,
-                manifested: false,
-                context: None,
-                false_flags: 0,
-                error: None,
-                not_driven: false,
-                test: None,
-            })
+            .map(host_tests::mc::Outcome::quiet)
             .collect();
         Part::new(c.clone(), [0, 1], nominal, faults, &outcomes)
     };
