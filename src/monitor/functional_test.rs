@@ -346,7 +346,9 @@ impl FunctionalTest {
         self.ticks = self.ticks.saturating_add(x.n);
         if tick < s.open_ticks {
             if tick >= s.measure_from {
-                let against = i64::from(along.saturating_neg().to_bits());
+                // A late call's sample stands for every tick it covers (n ≤ 255).
+                let against =
+                    i64::from(along.saturating_neg().to_bits()).saturating_mul(i64::from(x.n));
                 self.opening_sum = self.opening_sum.saturating_add(against);
             }
             return self.report;
