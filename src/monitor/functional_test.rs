@@ -351,12 +351,15 @@ impl FunctionalTest {
                     i64::from(along.saturating_neg().to_bits()).saturating_mul(i64::from(x.n));
                 self.opening_sum = self.opening_sum.saturating_add(against);
             }
+            if self.ticks >= s.open_ticks {
+                // The opening's last call: its mean, once.
+                let n = i64::from(s.open_ticks.saturating_sub(s.measure_from));
+                let mean = self.opening_sum.checked_div(n).unwrap_or(0);
+                self.report.opening_torque_nm = Q16::from_bits(i32::try_from(mean).unwrap_or(0));
+            }
             return self.report;
         }
         if tick < s.push_from {
-            let n = i64::from(s.open_ticks.saturating_sub(s.measure_from));
-            let mean = self.opening_sum.checked_div(n).unwrap_or(0);
-            self.report.opening_torque_nm = Q16::from_bits(i32::try_from(mean).unwrap_or(0));
             return self.report;
         }
         let rest = *self.rest_count.get_or_insert(x.out);
