@@ -287,8 +287,7 @@ impl Monitor {
             d_out: x.d_out,
             dir,
             load_dir: Dir::of(st.load.estimate.value(), k.scene.min_load),
-            load_abs: st.load.estimate.value().saturating_abs(),
-            capacity: st.load.cache.capacity,
+            decel: st.load.cache.decel,
         });
         let (fast, gave_way) = st.checks.every_tick(&k.checks, x, o, braking);
         if gave_way || st.slow.gave_way {
@@ -418,19 +417,26 @@ impl State {
             } else {
                 k.pack.drive_drag
             };
-            self.load
-                .learn(&k.load, o.net.saturating_add(c.dir.apply(pack)), x.n);
+            let driving = || o.net.saturating_add(c.dir.apply(k.pack.drive_drag));
+            self.load.learn(
+                &k.load,
+                o.net.saturating_add(c.dir.apply(pack)),
+                c.guessed.then(driving),
+                x.n,
+            );
         }
         let load = self.load.estimate.value();
         // The cache follows a changing load once per window while driving (never on a drive
         // edge); with the drive off the load is held, and so is the cache.
-        if x.drive && !x.drive_edge && WINDOW.slot(self.tick) == 0 && self.load.cache_stale(load) {
+        if x.drive && !x.drive_edge && WINDOW.slot(self.tick) == 0 && self.load.cache_stale() {
             self.refresh_load(k);
         }
         // Against an opposing load the load itself slows the output: the pack's torque there
         // is known only where both socket faces clamp (`learn_opposed`).
-        let learnable =
-            self.load.estimate.known().is_some() && (k.load.learn_opposed || c.load_along);
+        // With the load's sign a guess (`alt`) the pack's torque is not known either.
+        let learnable = self.load.estimate.known().is_some()
+            && self.load.alt.is_none()
+            && (k.load.learn_opposed || c.load_along);
         if moving_ok && !x.drive && learnable {
             let measured = load.saturating_sub(o.net);
             self.load.learn_health(&k.load, c.dir.apply(measured));
@@ -494,8 +500,12 @@ impl State {
     /// The load cache for the present load (its reciprocal and products).
     fn refresh_load(&mut self, k: &Settings) {
         let load = self.load.estimate.value();
-        let force = k.pack.clamped_force(load);
-        self.load.refresh(&k.load, load, k.pack.capacity(force));
+        let capacity = k.pack.capacity(k.pack.clamped_force(load));
+        let decel = k
+            .checks
+            .envelope
+            .decelerations(capacity, load.saturating_abs(), self.load.alt);
+        self.load.refresh(&k.load, load, capacity, decel);
     }
 
     /// The estimate of this tick: the last classification's, with this tick's count, energy,
@@ -506,6 +516,7 @@ impl State {
             friction_energy_j: self.energy.joules,
             trusted: commissioned
                 && self.load.estimate.known().is_some()
+                && self.load.alt.is_none()
                 && o.settled
                 && o.sensors_ok
                 && o.in_time

@@ -158,3 +158,13 @@ fn the_paper_reading_refuses_the_functional_test() {
     .unwrap_err();
     assert_eq!(e.key, "scene.reading");
 }
+
+/// The one healthy unit of seed 6174's campaign whose test an alarm aborted (docs/decisions.md,
+/// "The stuck counter counts net travel"): the drive's servo dithering while the brake held the
+/// output summed a path past the lost-motion limit. It passes now.
+#[test]
+fn a_healthy_unit_whose_servo_dithers_at_rest_passes() {
+    let d = host_tests::mc::draw_in(host_tests::family::Family::Plant, 6174, 8251, None);
+    let verdict = dormant::functional_test_after(&d, Config::default()).expect("twin");
+    assert_eq!(verdict, Some(dormant::Verdict::Pass));
+}

@@ -298,7 +298,9 @@ fn check_paper_case(load: f64, speed: f64, name: &str) {
     );
     assert_eq!(last.brake, BrakeState::Locked);
     assert_eq!(last.scene, Scene::Holding);
-    assert!(last.trusted);
+    // Powered on while driving along the load, the current alone cannot tell it from a light
+    // load against the motion: the overrunning reading is a guess, its estimate untrusted.
+    assert_eq!(last.trusted, load * speed < 0.0);
     assert!(!last.flags.any(), "false alarm: {:?}", last.flags);
     // Lock seen within 10 ms of the plant's (issue 4's target). The physical reading's dwell
     // is 1 ms, so the monitor may call the lock in the last ~1 ms of the plant's creep into
@@ -749,7 +751,8 @@ mod envelope {
             let last = trace.last().unwrap().2;
             prop_assert_eq!(last.brake, BrakeState::Locked);
             prop_assert!(!last.flags.any(), "{:?}", last.flags);
-            prop_assert!(last.trusted);
+            // Along the load the power-on reading is a guess (`check_paper_case`): untrusted.
+            prop_assert_eq!(last.trusted, load * speed < 0.0);
             let hold = last.braking_torque_nm.to_num::<f64>();
             prop_assert!((hold - load).abs() <= 0.05 * load.abs(), "hold {} vs {}", hold, load);
         }

@@ -47,3 +47,25 @@ fn a_healthy_run_ends_trusted_only_when_commissioned() {
     assert!(uncommissioned.iter().all(|e| !e.trusted));
     assert!(!uncommissioned.last().unwrap().flags.any());
 }
+
+/// Powered on while opening against a light load, the monitor cannot tell it from an aiding
+/// load (docs/monitor-design.md, "Ambiguity at power-on"): its estimate on that guess is never
+/// trusted, commissioned or not; a load outside the ambiguous band is.
+#[test]
+fn an_estimate_on_a_guessed_load_is_not_trusted() {
+    let run = |load: f64| {
+        let text = format!("[scene]\nkind = \"reverse_load\"\nload_torque_nm = {load}\n");
+        let scene = Scene::from_toml("trust", &text).unwrap();
+        let trace = scene_trace(&scene).unwrap();
+        run_monitor(&trace, Config::physical_reading()).unwrap()
+    };
+    let light = run(6.0);
+    // The guess: the load learned along the motion (aiding), the twin's opposes it.
+    let guessed = light
+        .iter()
+        .any(|e| e.load_torque_nm.to_num::<f64>() * e.output_speed_rad_s.to_num::<f64>() > 1.0);
+    assert!(guessed, "the light load was not learned as the guess");
+    assert!(light.iter().all(|e| !e.trusted));
+    assert!(!light.last().unwrap().flags.any());
+    assert!(run(20.3).last().unwrap().trusted);
+}

@@ -37,8 +37,8 @@ use crate::fx::Q16;
 use current_command::CommandCheck;
 use dead_current::DeadCurrent;
 use drive::{DriveChecks, DriveTick};
-pub(crate) use envelope::BrakingTick;
 use envelope::Envelope;
+pub(crate) use envelope::{BrakingTick, Decel};
 use hold::HoldChecks;
 
 /// The checks' constants.

@@ -254,9 +254,9 @@ pub struct Estimate {
     pub pack_health: Q16,
     /// Friction energy dissipated in the pack since power-on (J).
     pub friction_energy_j: U40F24,
-    /// Whether the estimate can be relied on (a commissioned monitor, load known, observer
-    /// settled, sensors plausible, no brake or sensor fault latched: a faulty plant is not the
-    /// model the estimate assumes).
+    /// Whether the estimate can be relied on (a commissioned monitor, load known and its sign
+    /// not a power-on guess, observer settled, sensors plausible, no brake or sensor fault
+    /// latched: a faulty plant is not the model the estimate assumes).
     pub trusted: bool,
     /// Latched failure flags.
     pub flags: Flags,

@@ -8,6 +8,7 @@
 //! | margin | [`Q16`], at most [`MARGIN_MAX`] | 0 … 1000 | 1.5e-5 |
 //! | health | [`Q16`], clamped | 0 … 2 | 1.5e-5 |
 
+use super::checks::Decel;
 use super::config::{Config, ConfigError};
 use super::convert::{filter_gain, positive, scale, ticks, Q16_ONE};
 use super::scale::{recip_q16, Scale};
@@ -100,8 +101,11 @@ impl LoadEstimate {
 #[derive(Clone, Copy, Debug)]
 pub(crate) struct LoadCache {
     load: Q16,
+    alt: Option<Q16>,
     /// Static capacity `μ_s·c·(F_s + k·|M̂|)` of the pack clamped by the load (drive off).
     pub capacity: Q16,
+    /// The braking envelope's deceleration torques.
+    pub decel: Decel,
     recip: Q16,
     /// `min_capacity_margin · |M̂|`.
     pub margin_floor: Q16,
@@ -125,6 +129,9 @@ pub(crate) struct Load {
     pub reference: Option<Q16>,
     pub health: Q16,
     pub cache: LoadCache,
+    /// The driving reading's load, learned beside the estimate while the overrunning reading
+    /// is a power-on guess (`Classified::guessed`): the estimate's sign is not known.
+    pub alt: Option<Q16>,
 }
 
 impl Load {
@@ -136,13 +143,19 @@ impl Load {
             health: Q16::ONE,
             cache: LoadCache {
                 load: Q16::ZERO,
+                alt: None,
                 capacity: Q16::ZERO,
+                decel: Decel {
+                    along: Q16::ZERO,
+                    opposed: Q16::ZERO,
+                },
                 recip: Q16::ZERO,
                 margin_floor: Q16::ZERO,
                 health: Q16::ONE,
                 available: Q16::ZERO,
                 margin: Q16::ZERO,
             },
+            alt: None,
         }
     }
 
@@ -156,11 +169,14 @@ impl Load {
     pub fn reading_changed(&mut self) {
         if let LoadEstimate::Learning(_) = self.estimate {
             (self.estimate, self.learn_ticks) = (LoadEstimate::Learning(Q16::ZERO), 0);
+            self.alt = None;
         }
     }
 
-    /// One slow-lane learning step with the load this call implies (`n` ticks elapsed).
-    pub fn learn(&mut self, k: &LoadSettings, implied: Q16, n: u32) {
+    /// One slow-lane learning step with the load this call implies (`n` ticks elapsed) and, on
+    /// a guessed reading, the other reading's; learning on a decided reading drops `alt`.
+    pub fn learn(&mut self, k: &LoadSettings, implied: Q16, other: Option<Q16>, n: u32) {
+        self.alt = other.map(|y| lowpass(self.alt.unwrap_or(self.estimate.value()), y, k.alpha));
         let value = lowpass(self.estimate.value(), implied, k.alpha);
         self.learn_ticks = self.learn_ticks.saturating_add(SLOW.covered(n));
         self.estimate = match self.estimate {
@@ -177,12 +193,15 @@ impl Load {
         };
     }
 
-    /// Refreshes the cache for `load` with its engaged `capacity`.
-    pub fn refresh(&mut self, k: &LoadSettings, load: Q16, capacity: Q16) {
+    /// Refreshes the cache for `load` with its engaged `capacity` and the braking model's
+    /// decelerations.
+    pub fn refresh(&mut self, k: &LoadSettings, load: Q16, capacity: Q16, decel: Decel) {
         let load_abs = load.saturating_abs();
         self.cache = LoadCache {
             load,
+            alt: self.alt,
             capacity,
+            decel,
             recip: Q16::from_bits(recip_q16(load_abs.to_bits())),
             margin_floor: Q16::from_bits(k.min_margin.apply(load_abs.to_bits())),
             health: self.health,
@@ -193,8 +212,8 @@ impl Load {
     }
 
     /// Whether the cache was formed for another load.
-    pub fn cache_stale(&self, load: Q16) -> bool {
-        self.cache.load != load
+    pub fn cache_stale(&self) -> bool {
+        self.cache.load != self.estimate.value() || self.cache.alt != self.alt
     }
 
     /// One slow-lane health step (sign-LMS, no division): the measured braking torque along
@@ -236,7 +255,7 @@ mod tests {
         let mut load = Load::new();
         // Learned under the overrunning reading (one call per slow-lane slot): 60 N·m, not known.
         for _ in 0..k.known_ticks / SLOW.ticks / 2 {
-            load.learn(&k, Q16::from_num(60), 1);
+            load.learn(&k, Q16::from_num(60), None, 1);
         }
         assert!(load.estimate.known().is_none() && load.estimate.value() > Q16::from_num(10));
         load.reading_changed();
@@ -244,7 +263,7 @@ mod tests {
         // Under the new reading the load is known after the full learning time, near −10 N·m.
         let mut calls = 0;
         while load.estimate.known().is_none() {
-            load.learn(&k, Q16::from_num(-10), 1);
+            load.learn(&k, Q16::from_num(-10), None, 1);
             calls += 1;
         }
         assert!(calls * SLOW.ticks >= k.known_ticks);

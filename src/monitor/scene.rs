@@ -11,7 +11,7 @@
 //! its drag) or the pack (`Overrunning`: the load runs along the motion). The current tells
 //! them apart only when the overrunning reading's load lies outside the envelope; otherwise the
 //! learned load's sign decides, and with no load known yet the overrunning reading is taken (the
-//! driving one for a `DrivingPack::SpringOnly` pack).
+//! driving one for a `DrivingPack::SpringOnly` pack) as a guess (`Classified::guessed`).
 //! After the first settled decision of a drive, the other reading must be wanted for
 //! `engage_settle_s` (and the step check must not be counting) before it switches.
 
@@ -90,6 +90,9 @@ impl SceneSettings {
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub(crate) struct Reading {
     pub overrunning: bool,
+    /// The overrunning reading was taken with no load known while the driving one fitted the
+    /// current as well: the load's sign is a guess until a later decision.
+    guessed: bool,
     /// Decided once this drive, on a settled observer.
     decided: bool,
     /// Ticks the other reading has been wanted.
@@ -126,6 +129,8 @@ pub(crate) struct Classified {
     pub load_along: bool,
     /// A change of driving reading is pending.
     pub pending: bool,
+    /// Overrunning on the power-on guess: the driving reading fitted the current as well.
+    pub guessed: bool,
     /// The reading changed this call (bumpless for the observer).
     pub reading_switch: bool,
     /// The brake locked this call.
@@ -147,6 +152,7 @@ impl Classified {
         overrun_torque: Q16::ZERO,
         load_along: false,
         pending: false,
+        guessed: false,
         reading_switch: false,
         just_locked: false,
         phase_settled: false,
@@ -263,7 +269,15 @@ impl Classify {
                     && implied > k.min_load
                     && implied <= k.max_load;
                 let wanted = possible && (load_along || (!known && k.overrun_when_unknown));
-                Phase::Driving(r.next(wanted, o.settled, n, k.engage_settle_ticks, step_counting))
+                let guess = !known && wanted;
+                Phase::Driving(r.next(
+                    wanted,
+                    guess,
+                    o.settled,
+                    n,
+                    k.engage_settle_ticks,
+                    step_counting,
+                ))
             }
             (false, p) => {
                 self.stick_ticks = if o.w.saturating_abs() < k.stick_speed {
@@ -315,6 +329,7 @@ impl Classify {
             overrun_torque,
             load_along,
             pending: matches!(self.phase, Phase::Driving(r) if r.pending_ticks != 0),
+            guessed: matches!(self.phase, Phase::Driving(r) if r.overrunning && r.guessed),
             reading_switch,
             just_locked,
             phase_settled: self.phase_ticks >= k.engage_settle_ticks,
@@ -363,6 +378,7 @@ impl Reading {
     const fn none() -> Reading {
         Reading {
             overrunning: false,
+            guessed: false,
             decided: false,
             pending_ticks: 0,
         }
@@ -370,9 +386,11 @@ impl Reading {
 
     /// Debounced: the first settled decision of a drive is taken at once; a later change only
     /// once wanted for `settle` ticks and not while the step check counts towards a verdict.
+    /// A decision made on the power-on default (`guess`) is marked so.
     fn next(
         self,
         wanted: bool,
+        guess: bool,
         settled: bool,
         n: u32,
         settle: u32,
@@ -382,6 +400,7 @@ impl Reading {
         if settled && !r.decided {
             r = Reading {
                 overrunning: wanted,
+                guessed: guess,
                 decided: true,
                 pending_ticks: 0,
             };
@@ -390,7 +409,7 @@ impl Reading {
         } else {
             r.pending_ticks = r.pending_ticks.saturating_add(n);
             if r.pending_ticks >= settle && !step_counting {
-                r.overrunning = wanted;
+                (r.overrunning, r.guessed) = (wanted, guess);
                 r.pending_ticks = 0;
             }
         }

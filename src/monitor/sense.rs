@@ -215,8 +215,10 @@ pub(crate) struct Sense {
     prev_motor: u32,
     prev_drive: bool,
     rail_ticks: u32,
-    still_out: u32,
-    still_motor: u32,
+    /// Net travel (counts, saturating) of the motor while the output counter stands still,
+    /// and of the output while the motor's does.
+    still_out: i32,
+    still_motor: i32,
     input_speed: Q16,
     /// The motor counter at the last input-speed sample.
     speed_motor: u32,
@@ -339,20 +341,21 @@ impl Sense {
         self.input_speed
     }
 
-    /// Stuck counter: while driving, one shaft travels beyond the lost-motion limit while the
-    /// other's counter stands still.
+    /// Stuck counter: while driving, one shaft's net travel passes the lost-motion limit while
+    /// the other's counter stands still (net, not path: a servo dithering at rest goes nowhere).
     fn stuck_counter(&mut self, k: &SenseSettings, d_out: i32, d_motor: i32) -> bool {
         self.still_out = if d_out == 0 {
-            self.still_out.saturating_add(d_motor.unsigned_abs())
+            self.still_out.saturating_add(d_motor)
         } else {
             0
         };
         self.still_motor = if d_motor == 0 {
-            self.still_motor.saturating_add(d_out.unsigned_abs())
+            self.still_motor.saturating_add(d_out)
         } else {
             0
         };
-        self.still_out > k.lost_motor_counts || self.still_motor > k.lost_out_counts
+        self.still_out.unsigned_abs() > k.lost_motor_counts
+            || self.still_motor.unsigned_abs() > k.lost_out_counts
     }
 
     /// One history entry per call with the drive off (counts mod 2^16, wrapping: only
@@ -415,5 +418,39 @@ fn rounded(x: f64) -> i32 {
         -((0.5 - x) as i32)
     } else {
         (x + 0.5) as i32
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The motor moving `steps` (counts per tick) while the output counter stands still.
+    fn stuck_after(steps: impl Iterator<Item = i32>) -> bool {
+        let k = SenseSettings::new(&Config::default()).expect("default configuration");
+        let (mut sense, mut motor) = (Sense::new(), 0_u32);
+        let mut stuck = false;
+        for d in steps {
+            motor = motor.wrapping_add_signed(d) & k.motor_mask;
+            let x = sense.read(&k, &Inputs::new(2100, motor, 100, true), 1, true);
+            stuck |= x.fault;
+        }
+        stuck
+    }
+
+    #[test]
+    fn the_stuck_counter_counts_net_travel_not_a_dithering_path() {
+        let k = SenseSettings::new(&Config::default()).expect("default configuration");
+        let limit = k.lost_motor_counts as i32;
+        // A servo dithering ±3 counts at rest for 10 limits' worth of path: not stuck.
+        assert!(!stuck_after((0..10 * limit / 3).map(|i| if i % 2 == 0 {
+            3
+        } else {
+            -3
+        })));
+        // Turning one way 3 counts a tick past the limit: stuck.
+        assert!(stuck_after((0..limit / 3 + 2).map(|_| 3)));
+        // Up to the limit: not yet.
+        assert!(!stuck_after((0..limit / 3 - 1).map(|_| 3)));
     }
 }

@@ -1,5 +1,6 @@
 //! The braking envelope (`brake_weak`): from the drive's cut, a nominal braking model —
-//! speed decreasing at `(T_all ∓ |M̂|)/J_s`, both socket faces clamping — stepped by explicit
+//! speed decreasing at `(T_all ∓ |M̂|)/J_s`, both socket faces clamping (no faster than an
+//! opposing load allows while the load's sign is a guess) — stepped by explicit
 //! Euler in I16F16 at `braking_model_hz`, gives the speed and angle a working pack allows; the
 //! output may overrun them by the allowances. A pack that does not brake at all is caught
 //! sooner: the output going further than it would at its cut speed, undecelerated.
@@ -139,8 +140,37 @@ pub(crate) struct BrakingTick {
     pub d_out: i32,
     pub dir: Dir,
     pub load_dir: Dir,
-    pub load_abs: Q16,
-    pub capacity: Q16,
+    /// The model's deceleration torque moving with the load and against it
+    /// ([`EnvelopeSettings::decelerations`], cached with the load).
+    pub decel: Decel,
+}
+
+/// The braking model's deceleration torques (N·m, ≥ 0) for one load.
+#[cfg_attr(
+    feature = "config-block",
+    derive(serde::Serialize, serde::Deserialize, Hash)
+)]
+#[derive(Clone, Copy, Debug, PartialEq, Default)]
+pub(crate) struct Decel {
+    pub along: Q16,
+    pub opposed: Q16,
+}
+
+impl EnvelopeSettings {
+    /// `T_all − |M̂|` moving with the load, `s·T_all + |M̂|` against it; while the load's sign
+    /// is a guess (`other`: the load under the other reading), moving with it no more than
+    /// against `other`.
+    pub fn decelerations(&self, capacity: Q16, load_abs: Q16, other: Option<Q16>) -> Decel {
+        let share = mul_q16(self.opposed_share, capacity);
+        let mut along = capacity.saturating_sub(load_abs);
+        if let Some(other) = other {
+            along = along.min(share.saturating_add(other.saturating_abs()));
+        }
+        Decel {
+            along: along.max(Q16::ZERO),
+            opposed: share.saturating_add(load_abs).max(Q16::ZERO),
+        }
+    }
 }
 
 impl Envelope {
@@ -177,11 +207,10 @@ impl Envelope {
     /// speed. Returns whether the pack is not braking at all.
     fn model_step(&mut self, k: &EnvelopeSettings, b: &BrakingTick) -> bool {
         let decel = if b.dir == b.load_dir {
-            b.capacity.saturating_sub(b.load_abs)
+            b.decel.along
         } else {
-            mul_q16(k.opposed_share, b.capacity).saturating_add(b.load_abs)
-        }
-        .max(Q16::ZERO);
+            b.decel.opposed
+        };
         // The usual step's constants are precomputed; a longer one (a late tick, or the first
         // step after an arm on an even tick) multiplies the per-tick ones.
         let (travel, dv, free) = if self.model_ticks == k.model_ticks {
