@@ -417,13 +417,10 @@ impl State {
             } else {
                 k.pack.drive_drag
             };
-            let driving = || o.net.saturating_add(c.dir.apply(k.pack.drive_drag));
-            self.load.learn(
-                &k.load,
-                o.net.saturating_add(c.dir.apply(pack)),
-                c.guessed.then(driving),
-                x.n,
-            );
+            // The load a pack torque implies; on a guess, the driving reading's beside it.
+            let implied = |t: Q16| o.net.saturating_add(c.dir.apply(t));
+            let other = c.guessed.then(|| implied(k.pack.drive_drag));
+            self.load.learn(&k.load, implied(pack), other, x.n);
         }
         let load = self.load.estimate.value();
         // The cache follows a changing load once per window while driving (never on a drive
@@ -431,9 +428,8 @@ impl State {
         if x.drive && !x.drive_edge && WINDOW.slot(self.tick) == 0 && self.load.cache_stale() {
             self.refresh_load(k);
         }
-        // Against an opposing load the load itself slows the output: the pack's torque there
-        // is known only where both socket faces clamp (`learn_opposed`).
-        // With the load's sign a guess (`alt`) the pack's torque is not known either.
+        // The pack's torque is known against an opposing load only where both socket faces
+        // clamp (`learn_opposed`), and not at all while the load's sign is a guess (`alt`).
         let learnable = self.load.estimate.known().is_some()
             && self.load.alt.is_none()
             && (k.load.learn_opposed || c.load_along);
@@ -504,7 +500,7 @@ impl State {
         let decel = k
             .checks
             .envelope
-            .decelerations(capacity, load.saturating_abs(), self.load.alt);
+            .decelerations(capacity, load, self.load.alt);
         self.load.refresh(&k.load, load, capacity, decel);
     }
 

@@ -160,8 +160,8 @@ impl EnvelopeSettings {
     /// `T_all − |M̂|` moving with the load, `s·T_all + |M̂|` against it; while the load's sign
     /// is a guess (`other`: the load under the other reading), moving with it no more than
     /// against `other`.
-    pub fn decelerations(&self, capacity: Q16, load_abs: Q16, other: Option<Q16>) -> Decel {
-        let share = mul_q16(self.opposed_share, capacity);
+    pub fn decelerations(&self, capacity: Q16, load: Q16, other: Option<Q16>) -> Decel {
+        let (share, load_abs) = (mul_q16(self.opposed_share, capacity), load.saturating_abs());
         let mut along = capacity.saturating_sub(load_abs);
         if let Some(other) = other {
             along = along.min(share.saturating_add(other.saturating_abs()));
