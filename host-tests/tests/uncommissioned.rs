@@ -76,3 +76,34 @@ fn the_physical_readings_settings_tighten_only_the_family_wide_limits() {
         }
     );
 }
+
+/// Tuning seed 1616's run 2875 (paper form, reverse load 27.4 N·m): after the stop the load
+/// turns the output back ≈ 0.2 rad through the ramps' lost motion before the pack clamps and
+/// slows it; the creep check allowed that span only while the output decelerates.
+#[test]
+fn a_load_turning_the_output_back_until_the_ramps_clamp_is_no_slip() {
+    use host_tests::family::Family;
+    use host_tests::mc::{draw_in, draw_trace};
+    let d = draw_in(Family::Plant, 1616, 2875, None);
+    let trace = draw_trace(&d).expect("twin");
+    let start = trace
+        .rows
+        .iter()
+        .rposition(|r| r.drive_on)
+        .expect("a drive");
+    let stop = trace.rows[start..]
+        .iter()
+        .map(|r| r.output_angle_rad)
+        .fold(f64::NEG_INFINITY, |a, b| a.max(-b));
+    let end = -trace.rows.last().expect("rows").output_angle_rad;
+    assert!(
+        stop - end > 0.15,
+        "turned back {:.3} rad, more than the creep limit",
+        stop - end
+    );
+    let acc = compare(
+        &trace,
+        &run_monitor(&trace, Family::Plant.config()).expect("monitor"),
+    );
+    assert!(acc.flags.is_empty(), "{:?}", acc.flag_times());
+}

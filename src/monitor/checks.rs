@@ -160,7 +160,7 @@ impl Checks {
             Some(b) if x.out_ok => raised.brake_weak = self.envelope.check(&k.envelope, &b),
             _ => {}
         }
-        let gave_way = !x.drive && x.out_ok && self.hold.creep(&k.hold, x.d_out);
+        let gave_way = !x.drive && x.out_ok && self.hold.creep(&k.hold, x.d_out, o.w.to_bits());
         raised.brake_slip = gave_way;
         (raised, gave_way)
     }
@@ -194,6 +194,7 @@ impl Checks {
             };
             raised.brake_weak = self.weak_ticks >= k.persistence_ticks;
             if !drive {
+                self.hold.track_speed(o.w.to_bits());
                 gave_way = self.hold.common_slip(&k.hold, x.out, x.motor);
                 raised.brake_slip = gave_way;
             }
