@@ -430,9 +430,7 @@ impl State {
         }
         // The pack's torque is known against an opposing load only where both socket faces
         // clamp (`learn_opposed`), and not at all while the load's sign is a guess (`alt`).
-        let learnable = self.load.estimate.known().is_some()
-            && self.load.alt.is_none()
-            && (k.load.learn_opposed || c.load_along);
+        let learnable = self.load.decided() && (k.load.learn_opposed || c.load_along);
         if moving_ok && !x.drive && learnable {
             let measured = load.saturating_sub(o.net);
             self.load.learn_health(&k.load, c.dir.apply(measured));
@@ -511,8 +509,7 @@ impl State {
             tick: self.tick,
             friction_energy_j: self.energy.joules,
             trusted: commissioned
-                && self.load.estimate.known().is_some()
-                && self.load.alt.is_none()
+                && self.load.decided()
                 && o.settled
                 && o.sensors_ok
                 && o.in_time

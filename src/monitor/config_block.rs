@@ -4,7 +4,7 @@
 //!
 //! | bytes | what |
 //! |---|---|
-//! | 4 | magic `NBC5` (a later layout of the settings changes it) |
+//! | 4 | magic `NBC4` (a later layout of the settings changes it) |
 //! | n | the monitor's settings (`Settings::new` of the `Config`), postcard |
 //! | 4 | CRC-32/ISCSI of the settings' bytes, little-endian (postcard's `use-crc` flavour) |
 //!
@@ -16,8 +16,8 @@ use super::{Config, ConfigError, Monitor};
 use crc::{Crc, CRC_32_ISCSI};
 
 /// The block's first bytes.
-pub const CONFIG_BLOCK_MAGIC: [u8; 4] = *b"NBC5";
-/// Room the firmware keeps for a block (the default settings take 289 bytes).
+pub const CONFIG_BLOCK_MAGIC: [u8; 4] = *b"NBC4";
+/// Room the firmware keeps for a block (the default settings take 287 bytes).
 pub const CONFIG_BLOCK_BYTES: usize = 1024;
 
 const CRC: Crc<u32> = Crc::<u32>::new(&CRC_32_ISCSI);
@@ -111,7 +111,7 @@ mod tests {
         let crc = u32::from_le_bytes(buf[n - 4..n].try_into().unwrap());
         assert_eq!(
             (n, crc),
-            (289, 0xA460_094B),
+            (287, 0x06D5_56E2),
             "length and CRC of the default block"
         );
     }

@@ -211,6 +211,12 @@ impl Load {
         self.cache_health();
     }
 
+    /// The load is known and its sign is not a power-on guess (`alt`): what trust and the
+    /// pack-health learning count on.
+    pub fn decided(&self) -> bool {
+        self.estimate.known().is_some() && self.alt.is_none()
+    }
+
     /// Whether the cache was formed for another load.
     pub fn cache_stale(&self) -> bool {
         self.cache.load != self.estimate.value() || self.cache.alt != self.alt

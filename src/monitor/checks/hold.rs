@@ -21,18 +21,17 @@ use crate::monitor::convert::{counts, positive};
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub(crate) struct HoldSettings {
     creep_counts: i32,
-    /// The span allowed while the output decelerates: twice `creep_counts`.
-    braking_counts: i32,
     slip: SlipLimits,
 }
 
 impl HoldSettings {
     pub fn new(c: &Config) -> Result<HoldSettings, ConfigError> {
         let out_rad = c.sensors.output_rad_per_count();
-        let creep = positive(c.thresholds.creep_limit_rad, "thresholds.creep_limit_rad")?;
         Ok(HoldSettings {
-            creep_counts: counts(creep / out_rad, "thresholds.creep_limit_rad")?,
-            braking_counts: counts(2.0 * creep / out_rad, "thresholds.creep_limit_rad")?,
+            creep_counts: counts(
+                positive(c.thresholds.creep_limit_rad, "thresholds.creep_limit_rad")? / out_rad,
+                "thresholds.creep_limit_rad",
+            )?,
             slip: SlipLimits::new(c)?,
         })
     }
@@ -96,7 +95,7 @@ impl HoldChecks {
         let span = self.creep_max.saturating_sub(self.creep_min);
         // Past the creep limit: slipped unless decelerating and within the braking span.
         let slipped = span > k.creep_counts
-            && (span > k.braking_counts
+            && (span > k.creep_counts.saturating_mul(2)
                 || w.saturating_abs() >= self.peak_speed.saturating_sub(self.peak_speed >> 3));
         if slipped {
             self.creep_valid = false;
