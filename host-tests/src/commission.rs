@@ -350,6 +350,7 @@ fn configured(base: Config, a: f64, share: f64, relieved: bool) -> Config {
         Thresholds::DEFAULT
     };
     cfg.thresholds.braking_angle_allowance_rad = t.braking_angle_allowance_rad;
+    cfg.thresholds.braking_angle_factor = t.braking_angle_factor;
     cfg.thresholds.opposed_braking_share = (share * BRAKING_SHARE_MARGIN).clamp(0.0, 1.0);
     // The dead-reading check needs a drive torque that never falls near zero while the output
     // turns: a relieved pack's drag (a·F_s/(1 + a·k)); a spring-only pack closes on almost none.

@@ -60,10 +60,12 @@ fn the_physical_readings_settings_tighten_only_the_family_wide_limits() {
     assert!(u.opposed_braking_share < p.opposed_braking_share);
     assert!(u.dead_current_nm < p.dead_current_nm);
     assert!(u.braking_angle_allowance_rad > p.braking_angle_allowance_rad);
+    assert!(u.braking_angle_factor > p.braking_angle_factor);
     let same = Thresholds {
         opposed_braking_share: p.opposed_braking_share,
         dead_current_nm: p.dead_current_nm,
         braking_angle_allowance_rad: p.braking_angle_allowance_rad,
+        braking_angle_factor: p.braking_angle_factor,
         ..u
     };
     assert_eq!(same, p, "every other threshold is shared");
@@ -106,4 +108,43 @@ fn a_load_turning_the_output_back_until_the_ramps_clamp_is_no_slip() {
         &run_monitor(&trace, Family::Plant.config()).expect("monitor"),
     );
     assert!(acc.flags.is_empty(), "{:?}", acc.flag_times());
+}
+
+/// Tuning seed 1616's run 791 (paper form, forward load 5.7 N·m, sliding at μ_d): after the cut
+/// the pack slows the output from 14.5 rad/s at ≈ 25 rad/s², a third of the nominal model's
+/// deceleration, through ≈ 4 rad (it needs 2.7× the model's braking angle); the uncommissioned
+/// envelope allows 4×, so this healthy plant raises nothing.
+#[test]
+fn a_pack_braking_at_a_third_of_the_model_is_not_weak_uncommissioned() {
+    use host_tests::family::Family;
+    use host_tests::mc::{draw_in, draw_trace};
+    let d = draw_in(Family::Plant, 1616, 791, None);
+    assert!(d.scene.faults.is_empty());
+    let trace = draw_trace(&d).expect("twin");
+    let cut = trace.rows.iter().position(|r| !r.drive_on).expect("a cut");
+    let from = trace.rows[cut].output_angle_rad;
+    let travel = trace.rows[cut..]
+        .iter()
+        .map(|r| (r.output_angle_rad - from).abs())
+        .fold(0.0, f64::max);
+    assert!(travel > 3.0, "braked within {travel:.2} rad");
+    let acc = compare(
+        &trace,
+        &run_monitor(&trace, Family::Plant.config()).expect("monitor"),
+    );
+    assert!(acc.flags.is_empty(), "{:?}", acc.flag_times());
+    // With the physical reading's factor (2×) and nothing else changed, it is called weak.
+    let tight = Config {
+        thresholds: Thresholds {
+            braking_angle_factor: Thresholds::PHYSICAL_READING.braking_angle_factor,
+            ..Thresholds::DEFAULT
+        },
+        ..Config::default()
+    };
+    let acc = compare(&trace, &run_monitor(&trace, tight).expect("monitor"));
+    assert!(
+        acc.flags.iter().any(|f| f.flag == "brake_weak"),
+        "{:?}",
+        acc.flag_times()
+    );
 }

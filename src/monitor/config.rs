@@ -182,7 +182,7 @@ impl Thresholds {
         slip_input_travel_rad: 0.045, // the kicks alone: ≤ 0.035 rad
         slip_reversal_rad: 0.001,
         braking_grace_s: 0.4,
-        braking_angle_factor: 2.0,
+        braking_angle_factor: 4.0, // the paper reading at μ_d: ≤ 2.7× the model's angle
         braking_angle_allowance_rad: 0.3, // the paper reading's pack: ≤ 0.2 rad past the model
         undecelerated_allowance_rad: 0.01,
         opposed_braking_share: 0.0, // the paper reading: only the load slows the output
@@ -215,6 +215,7 @@ impl Thresholds {
     /// Set for the twin's physical reading (the plant they were tuned on): what commissioning
     /// on that reading gives. Tighter than [`Thresholds::DEFAULT`] where the family differs.
     pub const PHYSICAL_READING: Thresholds = Thresholds {
+        braking_angle_factor: 2.0,
         braking_angle_allowance_rad: 0.1, // the twin's healthy pack stops within 0.07 rad
         opposed_braking_share: 1.0,       // both socket faces clamp from the cut
         dead_current_nm: 0.5,             // healthy ≥ 1.42 N·m; a dead reading's noise ≈ 0.13 N·m

@@ -17,7 +17,7 @@ use crc::{Crc, CRC_32_ISCSI};
 
 /// The block's first bytes.
 pub const CONFIG_BLOCK_MAGIC: [u8; 4] = *b"NBC4";
-/// Room the firmware keeps for a block (the default settings take 287 bytes).
+/// Room the firmware keeps for a block (the default settings take 288 bytes).
 pub const CONFIG_BLOCK_BYTES: usize = 1024;
 
 const CRC: Crc<u32> = Crc::<u32>::new(&CRC_32_ISCSI);
@@ -111,7 +111,7 @@ mod tests {
         let crc = u32::from_le_bytes(buf[n - 4..n].try_into().unwrap());
         assert_eq!(
             (n, crc),
-            (287, 0x06D5_56E2),
+            (288, 0xCDD0_453E),
             "length and CRC of the default block"
         );
     }

@@ -27,6 +27,7 @@ mod run;
 mod shell;
 mod slurm_test;
 mod snapshot;
+mod stack_bound;
 mod test;
 #[cfg(test)]
 mod tidy;

@@ -26,6 +26,9 @@ pub struct ProfileArgs {
     /// Print the profile as one JSON object.
     #[arg(long)]
     pub json: bool,
+    /// Also list the N hottest source lines of the tick (innermost workspace frame, per step).
+    #[arg(long, value_name = "N", default_value_t = 0)]
+    pub lines: usize,
 }
 
 /// The monitor's two entry points; a frame inside one of them is a stage of that lane.
@@ -107,7 +110,32 @@ pub fn main(a: &ProfileArgs) -> Result<i32, String> {
             println!("  {:>7.1}  {stage}", per_step(*n));
         }
     }
+    if a.lines > 0 {
+        println!(
+            "hottest lines of the tick (instructions per step, innermost frame in this workspace):"
+        );
+        for (line, n) in tick_lines(&elf, &counts)?.into_iter().take(a.lines) {
+            println!("  {:>7.1}  {line}", per_step(n));
+        }
+    }
     Ok(0)
+}
+
+/// The tick lane's counts summed per source line of the innermost frame, hottest first.
+fn tick_lines(elf: &str, counts: &HashMap<u32, u64>) -> Result<Vec<(String, u64)>, String> {
+    let loader = addr2line::Loader::new(elf).map_err(|e| format!("{elf}: {e}"))?;
+    let mut lines: HashMap<String, u64> = HashMap::new();
+    for (&pc, &n) in counts {
+        let names = frame_names(&loader, u64::from(pc))?;
+        if !names.iter().any(|f| f == LANES[0].1) {
+            continue;
+        }
+        let at = crate_line(&loader, u64::from(pc))?;
+        *lines.entry(at).or_insert(0) += n;
+    }
+    let mut rows: Vec<_> = lines.into_iter().collect();
+    rows.sort_by(|x, y| y.1.cmp(&x.1).then(x.0.cmp(&y.0)));
+    Ok(rows)
 }
 
 /// Executions per address, from QEMU's `exec` log (`Trace N: HOST [CPU/PC/FLAGS/…] NAME`).
@@ -164,6 +192,24 @@ fn by_stage(
         *lanes.entry(lane).or_default().entry(stage).or_insert(0) += n;
     }
     Ok(lanes)
+}
+
+/// `file:line` of `pc`'s innermost frame in the workspace's code (not the standard library's).
+fn crate_line(loader: &addr2line::Loader, pc: u64) -> Result<String, String> {
+    let mut frames = loader.find_frames(pc).map_err(|e| e.to_string())?;
+    while let Some(frame) = frames.next().map_err(|e| e.to_string())? {
+        let Some(l) = frame.location else { continue };
+        let file = l.file.unwrap_or("?");
+        if file.contains("/rustc/")
+            || file.contains("/library/")
+            || file.contains(".cargo/registry")
+        {
+            continue;
+        }
+        let file = file.rsplit_once("/src/").map_or(file, |(_, f)| f);
+        return Ok(format!("{file}:{}", l.line.unwrap_or(0)));
+    }
+    Ok("?".into())
 }
 
 /// The function names of `pc`'s frames, innermost first, without their hashes.
