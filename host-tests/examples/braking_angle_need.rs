@@ -7,7 +7,7 @@
 //! 10 000 and 1616).
 
 use host_tests::accuracy::{compare, run_monitor};
-use host_tests::family::{form, Family};
+use host_tests::family::{form, runs_and_seed, Family};
 use host_tests::mc::{draw_in, draw_trace};
 use noback_twin::scene::SceneKind;
 use noback_twin::trace::Trace;
@@ -22,14 +22,7 @@ fn weak(trace: &Trace, factor: f64) -> Result<bool, String> {
 
 fn main() -> Result<(), String> {
     let mut args = std::env::args().skip(1);
-    let runs: u64 = args
-        .next()
-        .map_or(Ok(10_000), |s| s.parse())
-        .map_err(|e| format!("RUNS: {e}"))?;
-    let seed: u64 = args
-        .next()
-        .map_or(Ok(1616), |s| s.parse())
-        .map_err(|e| format!("SEED: {e}"))?;
+    let (runs, seed) = runs_and_seed(&mut args, 10_000, 1616)?;
     let (mut worst, mut called) = (0.0_f64, 0);
     for i in 0..runs {
         let d = draw_in(Family::Plant, seed, i, None);

@@ -10,7 +10,7 @@
 
 use host_tests::accuracy::{compare, run_monitor, scene_trace};
 use host_tests::commission::commission;
-use host_tests::family::{form, Family};
+use host_tests::family::{form, runs_and_seed, Family};
 use host_tests::mc::{draw_in, draw_trace, not_driven};
 use noback::monitor::Config;
 use noback_twin::scene::SceneKind;
@@ -30,14 +30,7 @@ struct Tally {
 
 fn main() -> Result<(), String> {
     let mut args = std::env::args().skip(1);
-    let runs: u64 = args
-        .next()
-        .map_or(Ok(300), |s| s.parse())
-        .map_err(|e| format!("RUNS: {e}"))?;
-    let seed: u64 = args
-        .next()
-        .map_or(Ok(4242), |s| s.parse())
-        .map_err(|e| format!("SEED: {e}"))?;
+    let (runs, seed) = runs_and_seed(&mut args, 300, 4242)?;
     // (kind, load) of each acceptance run.
     let open = SceneKind::ReverseLoad;
     let close = SceneKind::ForwardLoad;

@@ -7,20 +7,13 @@
 //! 400 and 1616).
 
 use host_tests::accuracy::{compare, run_monitor};
-use host_tests::family::{form, Family};
+use host_tests::family::{form, runs_and_seed, Family};
 use host_tests::mc::{draw_in, draw_trace, not_driven};
 use std::collections::BTreeMap;
 
 fn main() -> Result<(), String> {
     let mut args = std::env::args().skip(1);
-    let runs: u64 = args
-        .next()
-        .map_or(Ok(400), |s| s.parse())
-        .map_err(|e| format!("RUNS: {e}"))?;
-    let seed: u64 = args
-        .next()
-        .map_or(Ok(1616), |s| s.parse())
-        .map_err(|e| format!("SEED: {e}"))?;
+    let (runs, seed) = runs_and_seed(&mut args, 400, 1616)?;
     let mut runs_by: BTreeMap<String, usize> = BTreeMap::new();
     let mut flags_by: BTreeMap<String, usize> = BTreeMap::new();
     for i in 0..runs {

@@ -12,7 +12,7 @@
 
 use host_tests::accuracy::{run_functional_test, scene_trace};
 use host_tests::dormant;
-use host_tests::family::Family;
+use host_tests::family::{runs_and_seed, Family};
 use host_tests::mc::{draw_in, run_rng};
 use noback::monitor::functional_test::{TestConfig, TestResult};
 use noback::monitor::Config;
@@ -31,14 +31,7 @@ fn test_scene(base: &Scene, load_nm: f64, fault: Option<(FaultKind, f64)>) -> Sc
 
 fn main() -> Result<(), String> {
     let mut args = std::env::args().skip(1);
-    let runs: u64 = args
-        .next()
-        .map_or(Ok(200), |s| s.parse())
-        .map_err(|e| format!("RUNS: {e}"))?;
-    let seed: u64 = args
-        .next()
-        .map_or(Ok(4242), |s| s.parse())
-        .map_err(|e| format!("SEED: {e}"))?;
+    let (runs, seed) = runs_and_seed(&mut args, 200, 4242)?;
     let kinds = [
         FaultKind::SpringBroken,
         FaultKind::RampJam,

@@ -84,6 +84,21 @@ pub fn draw_form(scene: &mut Scene, rng: &mut Rng) {
     scene.noise.current_offset_a = offset;
 }
 
+/// The family examples' leading `[RUNS] [SEED]` arguments, each defaulted when absent; a value
+/// that is not a number is an error naming it.
+pub fn runs_and_seed(
+    args: &mut impl Iterator<Item = String>,
+    runs: u64,
+    seed: u64,
+) -> Result<(u64, u64), String> {
+    let mut next = |default: u64, name: &str| {
+        args.next()
+            .map_or(Ok(default), |s| s.parse())
+            .map_err(|e| format!("{name}: {e}"))
+    };
+    Ok((next(runs, "RUNS")?, next(seed, "SEED")?))
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

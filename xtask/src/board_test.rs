@@ -93,7 +93,7 @@ pub fn stage() -> Result<u32, String> {
 }
 
 /// The part's static stack bound (`stack_bound`) beside issue 15's budget. Printed, not yet
-/// enforced: today's image is over it (init alone, interrupts masked, needs ≈ 4.9 KB).
+/// enforced: the image is over it at init (docs/decisions.md, "The part's stack").
 fn print_stack_bound(elf: &str, ram_bytes: u64) -> Result<(), String> {
     let b = crate::stack_bound::bound(elf)?;
     let bytes =

@@ -26,7 +26,8 @@ pub struct ProfileArgs {
     /// Print the profile as one JSON object.
     #[arg(long)]
     pub json: bool,
-    /// Also list the N hottest source lines of the tick (innermost workspace frame, per step).
+    /// Also list the N hottest source lines of the tick (innermost workspace frame, per step;
+    /// `tick_lines` in the JSON).
     #[arg(long, value_name = "N", default_value_t = 0)]
     pub lines: usize,
 }
@@ -75,7 +76,8 @@ pub fn main(a: &ProfileArgs) -> Result<i32, String> {
     let _ = std::fs::remove_file(&fifo);
     let bench = run::line_with(&outcome.lines, "bench")?;
     let steps: u64 = run::field(&bench, "steps")?;
-    let lanes = by_stage(&elf, &counts)?;
+    let (lanes, lines) = by_stage(&elf, &counts, a.lines > 0)?;
+    let lines = &lines[..a.lines.min(lines.len())];
     let per_step = |n: u64| (n as f64 / steps.max(1) as f64 * 10.0).round() / 10.0;
     if a.json {
         let mut out = serde_json::Map::new();
@@ -93,6 +95,13 @@ pub fn main(a: &ProfileArgs) -> Result<i32, String> {
         out.insert("scene".into(), json!(a.scene));
         out.insert("core".into(), json!(a.core.name()));
         out.insert("steps".into(), json!(steps));
+        if a.lines > 0 {
+            let rows: Vec<_> = lines
+                .iter()
+                .map(|(line, n)| json!({"line": line, "insns_per_step": per_step(*n)}))
+                .collect();
+            out.insert("tick_lines".into(), json!(rows));
+        }
         println!("{}", serde_json::Value::Object(out));
         return Ok(0);
     }
@@ -114,28 +123,11 @@ pub fn main(a: &ProfileArgs) -> Result<i32, String> {
         println!(
             "hottest lines of the tick (instructions per step, innermost frame in this workspace):"
         );
-        for (line, n) in tick_lines(&elf, &counts)?.into_iter().take(a.lines) {
-            println!("  {:>7.1}  {line}", per_step(n));
+        for (line, n) in lines {
+            println!("  {:>7.1}  {line}", per_step(*n));
         }
     }
     Ok(0)
-}
-
-/// The tick lane's counts summed per source line of the innermost frame, hottest first.
-fn tick_lines(elf: &str, counts: &HashMap<u32, u64>) -> Result<Vec<(String, u64)>, String> {
-    let loader = addr2line::Loader::new(elf).map_err(|e| format!("{elf}: {e}"))?;
-    let mut lines: HashMap<String, u64> = HashMap::new();
-    for (&pc, &n) in counts {
-        let names = frame_names(&loader, u64::from(pc))?;
-        if !names.iter().any(|f| f == LANES[0].1) {
-            continue;
-        }
-        let at = crate_line(&loader, u64::from(pc))?;
-        *lines.entry(at).or_insert(0) += n;
-    }
-    let mut rows: Vec<_> = lines.into_iter().collect();
-    rows.sort_by(|x, y| y.1.cmp(&x.1).then(x.0.cmp(&y.0)));
-    Ok(rows)
 }
 
 /// Executions per address, from QEMU's `exec` log (`Trace N: HOST [CPU/PC/FLAGS/…] NAME`).
@@ -160,12 +152,15 @@ fn exec_address(line: &str) -> Option<u32> {
 
 /// Counts summed per lane and stage: the stage is the frame called from the lane's entry
 /// point (with its hash and crate path cut), or the entry's own code.
+/// With `lines`, also the tick's counts per source line ([`crate_line`]), hottest first.
 fn by_stage(
     elf: &str,
     counts: &HashMap<u32, u64>,
-) -> Result<BTreeMap<&'static str, BTreeMap<String, u64>>, String> {
+    lines: bool,
+) -> Result<(Lanes, Vec<(String, u64)>), String> {
     let loader = addr2line::Loader::new(elf).map_err(|e| format!("{elf}: {e}"))?;
-    let mut lanes: BTreeMap<&'static str, BTreeMap<String, u64>> = BTreeMap::new();
+    let mut lanes = Lanes::new();
+    let mut tick_lines: HashMap<String, u64> = HashMap::new();
     for (&pc, &n) in counts {
         let names = frame_names(&loader, u64::from(pc))?;
         // The outermost frame that is a lane's entry point (frames run innermost first).
@@ -190,9 +185,19 @@ fn by_stage(
             None => format!("({lane}'s own code)"),
         };
         *lanes.entry(lane).or_default().entry(stage).or_insert(0) += n;
+        if lines && lane == LANES[0].0 {
+            *tick_lines
+                .entry(crate_line(&loader, u64::from(pc))?)
+                .or_insert(0) += n;
+        }
     }
-    Ok(lanes)
+    let mut rows: Vec<_> = tick_lines.into_iter().collect();
+    rows.sort_by(|x, y| y.1.cmp(&x.1).then(x.0.cmp(&y.0)));
+    Ok((lanes, rows))
 }
+
+/// Counts per lane and stage.
+type Lanes = BTreeMap<&'static str, BTreeMap<String, u64>>;
 
 /// `file:line` of `pc`'s innermost frame in the workspace's code (not the standard library's).
 fn crate_line(loader: &addr2line::Loader, pc: u64) -> Result<String, String> {
