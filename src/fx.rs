@@ -18,6 +18,34 @@ pub type Q16 = I16F16;
 /// Filter gain in [0, 1), resolution 2⁻¹⁶.
 pub type Gain = U0F16;
 
+/// `a·b`, exact. On ARMv6-M from 16-bit halves ([`widening_mul_by_halves`]): the runtime's
+/// `__aeabi_lmul` multiplies 64 × 64 bits out of line; elsewhere the core's own long multiply.
+#[inline]
+pub fn widening_mul(a: i32, b: i32) -> i64 {
+    #[cfg(armv6m)]
+    {
+        widening_mul_by_halves(a, b)
+    }
+    #[cfg(not(armv6m))]
+    {
+        i64::from(a) * i64::from(b)
+    }
+}
+
+/// `a·b` from four 16 × 16-bit products, each exact in 32 bits (|aₕ·b_l| < 2³¹): the same
+/// value as the 64-bit product, for cores without a long multiply.
+#[inline]
+pub fn widening_mul_by_halves(a: i32, b: i32) -> i64 {
+    let (ah, al) = (a >> 16, a & 0xFFFF);
+    let (bh, bl) = (b >> 16, b & 0xFFFF);
+    // None of these overflows; wrapping keeps every profile free of a panic path.
+    let low = i64::from((al as u32).wrapping_mul(bl as u32));
+    let mid = i64::from(ah.wrapping_mul(bl)).wrapping_add(i64::from(al.wrapping_mul(bh)));
+    (i64::from(ah.wrapping_mul(bh)) << 32)
+        .wrapping_add(mid << 16)
+        .wrapping_add(low)
+}
+
 /// Signed difference `now − prev` of an `bits`-wide up/down counter, **wrapping** by design:
 /// the result is the shortest signed step in `[-2^(bits-1), 2^(bits-1))`. Bits above `bits` in the
 /// inputs are ignored; `bits` is clamped to 1..=32.
@@ -96,7 +124,42 @@ pub fn sat_i32(x: i64) -> i32 {
 
 #[cfg(test)]
 mod tests {
-    use super::sat_i32;
+    extern crate std;
+    use super::{sat_i32, widening_mul_by_halves};
+
+    #[test]
+    fn the_product_by_halves_is_the_long_product() {
+        let edges = [
+            i32::MIN,
+            i32::MIN + 1,
+            -65_537,
+            -65_536,
+            -65_535,
+            -1,
+            0,
+            1,
+            65_535,
+            65_536,
+            i32::MAX,
+        ];
+        let mut state = 0x9E37_79B9_u32; // xorshift: a fixed, reproducible spread of operands
+        let mut next = || {
+            state ^= state << 13;
+            state ^= state >> 17;
+            state ^= state << 5;
+            state as i32
+        };
+        let randoms: std::vec::Vec<i32> = (0..2_000).map(|_| next()).collect();
+        for &a in edges.iter().chain(&randoms) {
+            for &b in edges.iter().chain(&randoms[..200]) {
+                assert_eq!(
+                    widening_mul_by_halves(a, b),
+                    i64::from(a) * i64::from(b),
+                    "{a}·{b}"
+                );
+            }
+        }
+    }
 
     /// The clamp `sat_i32` replaces (two 64-bit compares).
     fn clamp_reference(x: i64) -> i32 {

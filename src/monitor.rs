@@ -104,7 +104,7 @@ pub const MARGIN_MAX: Q16 = Q16::from_bits(1000 << 16);
 pub fn mul_q16(a: Q16, b: Q16) -> Q16 {
     // |a·b| ≤ 2^62: the product fits an i64; `>> 16` is the floor.
     Q16::from_bits(sat_i32(
-        (i64::from(a.to_bits()) * i64::from(b.to_bits())) >> 16,
+        crate::fx::widening_mul(a.to_bits(), b.to_bits()) >> 16,
     ))
 }
 

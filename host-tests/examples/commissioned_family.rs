@@ -46,7 +46,7 @@ fn main() -> Result<(), String> {
     for i in 0..runs {
         let d = draw_in(Family::Plant, seed, i, None);
         let trace = draw_trace(&d)?;
-        if not_driven(&trace) {
+        if not_driven(&trace, &d.scene.sensors) {
             continue;
         }
         let t = by.entry(form(&d.scene).to_string()).or_default();

@@ -16,15 +16,20 @@ fn main() -> Result<(), String> {
     let (runs, seed) = runs_and_seed(&mut args, 400, 1616)?;
     let mut runs_by: BTreeMap<String, usize> = BTreeMap::new();
     let mut flags_by: BTreeMap<String, usize> = BTreeMap::new();
+    let (mut apart, mut apart_quiet) = (0, 0);
     for i in 0..runs {
         let d = draw_in(Family::Plant, seed, i, None);
         let key = format!("{} {:?}", form(&d.scene), d.scene.kind);
         *runs_by.entry(key.clone()).or_default() += 1;
         let trace = draw_trace(&d)?;
         let acc = compare(&trace, &run_monitor(&trace, Family::Plant.config())?);
+        if not_driven(&trace, &d.scene.sensors) {
+            apart += 1;
+            apart_quiet += usize::from(acc.flags.is_empty());
+        }
         if let Some(f) = acc.flags.first() {
             let mu = d.scene.open.paper_sliding_mu_static;
-            let apart = if not_driven(&trace) {
+            let apart = if not_driven(&trace, &d.scene.sensors) {
                 ", not driven: apart"
             } else {
                 ""
@@ -38,6 +43,7 @@ fn main() -> Result<(), String> {
     for (k, n) in &runs_by {
         println!("{n:6}  {k}");
     }
+    println!("input apart from output (counted apart): {apart}, of which no flag: {apart_quiet}");
     println!("false alarms by first flag:");
     for (k, n) in &flags_by {
         println!("{n:6}  {k}");

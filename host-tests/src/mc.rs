@@ -21,6 +21,7 @@ use crate::dormant::{functional_test_after, Verdict};
 use crate::family::Family;
 use noback::mechanism::Mechanism;
 use noback::monitor::Config;
+use noback::sensors::SensorConfig;
 use noback_twin::fault::{Fault, FaultKind};
 use noback_twin::reading::Reading;
 use noback_twin::scene::{Scene, SceneKind};
@@ -72,7 +73,7 @@ pub struct Outcome {
     pub false_flags_with_command: usize,
     /// The twin failed to run this draw (reported, never silently dropped).
     pub error: Option<String>,
-    /// A nominal draw whose plant does not move its output while driven ([`not_driven`]):
+    /// A nominal draw whose plant's input comes apart from its output ([`not_driven`]):
     /// counted apart from the false alarms, whatever the monitor raised.
     pub not_driven: bool,
     /// The functional test after the run ([`crate::dormant`]): every dormant fault run and a
@@ -103,26 +104,38 @@ impl Outcome {
     }
 }
 
-/// Input travel (rad, output side) with the output encoder standing still and the drive on
-/// beyond which a draw's plant is not driving its door: a jammed or decoupled actuator, which
-/// a monitor should flag. Healthy draws of both readings stay below 0.13 rad (seed 1616).
-pub const NOT_DRIVEN_RAD: f64 = 1.0;
+/// Input travel (rad, output side) against a still output beyond which a draw's plant has come
+/// apart: no ramp lets its input turn that far (the lost motion is 0.03–0.1 rad) — a jammed or
+/// decoupled actuator, which a monitor should flag. Healthy draws stay below 0.14 rad (seed 1616).
+pub const NOT_DRIVEN_RAD: f64 = 0.3;
 
-/// Whether the trace's drive turns its input by [`NOT_DRIVEN_RAD`] with the output still.
-pub fn not_driven(trace: &Trace) -> bool {
-    let (mut travel, mut out) = (0.0, None);
-    let mut prev_t = trace.rows.first().map_or(0.0, |r| r.t_s);
+/// The largest step (rad, output side) a healthy input makes in one 10 kHz sample, ×5: 0.002
+/// rad (20 rad/s) on every healthy draw of seed 1616. A larger step is the paper reading
+/// re-seating its input, not a shaft turning.
+pub const INPUT_STEP_RAD: f64 = 0.01;
+
+/// Whether the trace's motor encoder turns its input by [`NOT_DRIVEN_RAD`] while the output
+/// encoder stands still, with the drive on or off, or steps it by [`INPUT_STEP_RAD`] in one
+/// sample (the paper reading re-seats a runaway input on the output's far face after the cut).
+pub fn not_driven(trace: &Trace, sensors: &SensorConfig) -> bool {
+    let rad_per_count = sensors.input_rad_per_motor_count();
+    let shift = 32 - u32::from(sensors.motor_counter_bits);
+    let (mut travel, mut out, mut motor) = (0.0, None, None);
     for r in &trace.rows {
-        let dt = r.t_s - prev_t;
-        prev_t = r.t_s;
-        if !r.drive_on || out != Some(r.output_count) {
+        // Counter difference modulo 2^bits, as the shortest signed step.
+        let step = motor.map_or(0, |m: u32| {
+            (r.motor_count.wrapping_sub(m) << shift) as i32 >> shift
+        });
+        let step_rad = f64::from(step.unsigned_abs()) * rad_per_count;
+        if out != Some(r.output_count) {
             (travel, out) = (0.0, Some(r.output_count));
         } else {
-            travel += (r.input_speed_rad_s * dt).abs();
-            if travel > NOT_DRIVEN_RAD {
-                return true;
-            }
+            travel += step_rad;
         }
+        if travel > NOT_DRIVEN_RAD || step_rad > INPUT_STEP_RAD {
+            return true;
+        }
+        motor = Some(r.motor_count);
     }
     false
 }
@@ -427,7 +440,7 @@ pub fn evaluate(d: &Draw, campaign: &Campaign) -> Outcome {
     };
     let onset = fault.map_or(f64::INFINITY, |f| f.at_s);
     let manifested = fault.is_some_and(|f| manifest_time(&f, &trace).is_some());
-    let not_driven = fault.is_none() && not_driven(&trace);
+    let not_driven = fault.is_none() && not_driven(&trace, &d.scene.sensors);
     let every = campaign.test_every;
     let tested = every > 0
         && match fault {

@@ -5,7 +5,7 @@
 //! Loads span the Monte Carlo's 5–30 N·m. Above capacity/1.5 the margin is below the limit by
 //! definition (`brake_weak` is the right answer); below 5 N·m the paper reading's drag while
 //! driving (3.7–7.8 N·m against the model's 1.98) leaves the reading ambiguous uncommissioned
-//! (docs/decisions.md). A plant that does not move its output while driven (the paper
+//! (docs/decisions.md). A plant whose input comes apart from its output (the paper
 //! reading's closing at loads up to 8 N·m) is not healthy: the monitor must flag it.
 
 use host_tests::accuracy::{compare, run_monitor, scene_trace};
@@ -35,7 +35,7 @@ fn healthy_scenes_of_both_readings_raise_nothing_uncommissioned() {
                     &trace,
                     &run_monitor(&trace, Config::default()).expect("monitor"),
                 );
-                if not_driven(&trace) {
+                if not_driven(&trace, &scene.sensors) {
                     not_moving += 1;
                     assert!(
                         !acc.flags.is_empty(),
@@ -147,4 +147,32 @@ fn a_pack_braking_at_a_third_of_the_model_is_not_weak_uncommissioned() {
         "{:?}",
         acc.flag_times()
     );
+}
+
+/// Tuning seed 1616's run 5115 (paper form, forward load 5.1 N·m, sliding at μ_s): the pack
+/// holds the door on its spring while the drive's reference runs on, and at the stop the
+/// reading re-seats its input on the far face, a 0.76 rad step of the motor encoder. Counted
+/// apart, and flagged; run 8289 (physical form, forward load), the most input travel against a
+/// still output of any healthy draw of that seed's first 10 000, is a healthy plant.
+#[test]
+fn an_input_that_comes_apart_from_its_output_is_counted_apart_and_flagged() {
+    use host_tests::family::Family;
+    use host_tests::mc::{draw_in, draw_trace};
+    let d = draw_in(Family::Plant, 1616, 5115, None);
+    let trace = draw_trace(&d).expect("twin");
+    assert!(not_driven(&trace, &d.scene.sensors));
+    let acc = compare(
+        &trace,
+        &run_monitor(&trace, Family::Plant.config()).expect("monitor"),
+    );
+    assert!(
+        acc.flags.iter().any(|f| f.flag == "sensor_fault"),
+        "{:?}",
+        acc.flag_times()
+    );
+    let d = draw_in(Family::Plant, 1616, 8289, None);
+    assert!(!not_driven(
+        &draw_trace(&d).expect("twin"),
+        &d.scene.sensors
+    ));
 }

@@ -85,7 +85,7 @@ impl<const S: u32> Scale<S> {
     #[inline]
     pub fn apply(self, x: i32) -> i32 {
         // |x·mul| < 2^31·2^31 = 2^62 and the rounding term ≤ 2^61: the sum fits an i64.
-        let wide = i64::from(x) * i64::from(self.mul) + (1_i64 << (S - 1));
+        let wide = crate::fx::widening_mul(x, self.mul) + (1_i64 << (S - 1));
         if S >= 32 {
             // |wide| < 2^62 + 2^61 → |wide >> S| < 2^31: exact conversion.
             (wide >> S) as i32

@@ -79,7 +79,7 @@ fn form_lines(r: &Value) -> String {
     let Some(forms) = r["by_form"].as_object() else {
         return String::new();
     };
-    let mut s = String::from("\n| plant form | nominal runs | with a false alarm | rate [95 % interval] | not driven (apart) |\n|---|---|---|---|---|\n");
+    let mut s = String::from("\n| plant form | nominal runs | with a false alarm | rate [95 % interval] | input apart from output (apart) |\n|---|---|---|---|---|\n");
     for (form, v) in forms {
         let fa = &v["false_alarm"];
         let _ = writeln!(
@@ -101,7 +101,7 @@ pub fn table(r: &Value) -> String {
     let mut s = String::new();
     let _ = writeln!(
         s,
-        "{} Twin errors: {}. Nominal draws whose plant does not move its output while driven \
+        "{} Twin errors: {}. Nominal draws whose plant's input comes apart from its output \
          (counted apart): {}.\n",
         false_alarm_line(r),
         r["twin_errors"].as_array().map_or(0, Vec::len),
@@ -333,7 +333,7 @@ pub fn doc(r: &Value, record: Option<&Value>) -> String {
          continuous_closing); drive cut at 0.1–0.3 s; every Table 2 parameter scaled by its \
          own factor in [0.9, 1.1]; current noise 0–0.1 A; the load in either direction (a mirrored run negates \
          every sensor reading). Any flag in a nominal run is a false alarm, except in a draw \
-         whose plant does not move its output while driven (counted apart: `model.md`, \
+         whose plant's input comes apart from its output (counted apart: `model.md`, \
          \"The plant family\").\n\
          - Fault draws: the same plus one fault, onset uniform over the scene, severity \
          0.5–1 (each kind's meaning is in `model.md`).\n\
