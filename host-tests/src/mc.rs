@@ -19,6 +19,7 @@ use crate::accuracy::{
 };
 use crate::dormant::{functional_test_after, Verdict};
 use crate::family::Family;
+use noback::fx::counter_delta;
 use noback::mechanism::Mechanism;
 use noback::monitor::Config;
 use noback::sensors::SensorConfig;
@@ -119,12 +120,10 @@ pub const INPUT_STEP_RAD: f64 = 0.01;
 /// sample (the paper reading re-seats a runaway input on the output's far face after the cut).
 pub fn not_driven(trace: &Trace, sensors: &SensorConfig) -> bool {
     let rad_per_count = sensors.input_rad_per_motor_count();
-    let shift = 32 - u32::from(sensors.motor_counter_bits);
     let (mut travel, mut out, mut motor) = (0.0, None, None);
     for r in &trace.rows {
-        // Counter difference modulo 2^bits, as the shortest signed step.
-        let step = motor.map_or(0, |m: u32| {
-            (r.motor_count.wrapping_sub(m) << shift) as i32 >> shift
+        let step = motor.map_or(0, |m| {
+            counter_delta(m, r.motor_count, sensors.motor_counter_bits)
         });
         let step_rad = f64::from(step.unsigned_abs()) * rad_per_count;
         if out != Some(r.output_count) {
