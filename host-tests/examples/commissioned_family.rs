@@ -30,7 +30,7 @@ struct Tally {
 
 fn main() -> Result<(), String> {
     let mut args = std::env::args().skip(1);
-    let (runs, seed) = runs_and_seed(&mut args, 300, 4242)?;
+    let (runs, seed) = runs_and_seed(&mut args, 300, 4242);
     // (kind, load) of each acceptance run.
     let open = SceneKind::ReverseLoad;
     let close = SceneKind::ForwardLoad;

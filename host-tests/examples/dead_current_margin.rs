@@ -9,6 +9,7 @@
 //! `cargo run --release -p host-tests --example dead_current_margin -- [RUNS] [SEED]`
 //! (defaults 2000 and 2026). docs/decisions.md, "Dead current reading check", quotes it.
 
+use host_tests::family::runs_and_seed;
 use host_tests::mc::{draw_legacy as draw, draw_trace};
 use noback::monitor::Config;
 use noback::sensors::SensorConfig;
@@ -21,8 +22,7 @@ const MEMORY: u32 = 32;
 
 fn main() {
     let mut args = std::env::args().skip(1);
-    let runs: u64 = args.next().and_then(|a| a.parse().ok()).unwrap_or(2000);
-    let seed: u64 = args.next().and_then(|a| a.parse().ok()).unwrap_or(2026);
+    let (runs, seed) = runs_and_seed(&mut args, 2000, 2026);
     let config = Config::physical_reading();
     let s: SensorConfig = config.sensors;
     let nm_per_code = s.input_torque_nm(s.amps_per_count());

@@ -12,6 +12,7 @@
 //! 500 and 2026).
 
 use host_tests::accuracy::{compare, detection_latency_s, manifest_time, run_monitor};
+use host_tests::family::runs_and_seed;
 use host_tests::mc::{draw_legacy as draw, draw_trace, scene_after, Context, Draw, PRE_ROLL_S};
 use noback::monitor::Config;
 use noback_twin::fault::FaultKind;
@@ -74,8 +75,7 @@ fn first_free_run_end(samples: &[Sample], from: f64) -> Option<f64> {
 
 fn main() -> Result<(), String> {
     let mut args = std::env::args().skip(1);
-    let runs: u64 = args.next().and_then(|a| a.parse().ok()).unwrap_or(500);
-    let seed: u64 = args.next().and_then(|a| a.parse().ok()).unwrap_or(2026);
+    let (runs, seed) = runs_and_seed(&mut args, 500, 2026);
     let config = Config::physical_reading();
     let (mut manifested, mut detected, mut cc_missed, mut in_time) = (0, 0, 0, 0);
     println!(

@@ -13,7 +13,7 @@ use std::collections::BTreeMap;
 
 fn main() -> Result<(), String> {
     let mut args = std::env::args().skip(1);
-    let (runs, seed) = runs_and_seed(&mut args, 400, 1616)?;
+    let (runs, seed) = runs_and_seed(&mut args, 400, 1616);
     let mut runs_by: BTreeMap<String, usize> = BTreeMap::new();
     let mut flags_by: BTreeMap<String, usize> = BTreeMap::new();
     let (mut apart, mut apart_quiet) = (0, 0);
@@ -23,17 +23,14 @@ fn main() -> Result<(), String> {
         *runs_by.entry(key.clone()).or_default() += 1;
         let trace = draw_trace(&d)?;
         let acc = compare(&trace, &run_monitor(&trace, Family::Plant.config())?);
-        if not_driven(&trace, &d.scene.sensors) {
+        let is_apart = not_driven(&trace, &d.scene.sensors);
+        if is_apart {
             apart += 1;
             apart_quiet += usize::from(acc.flags.is_empty());
         }
         if let Some(f) = acc.flags.first() {
             let mu = d.scene.open.paper_sliding_mu_static;
-            let apart = if not_driven(&trace, &d.scene.sensors) {
-                ", not driven: apart"
-            } else {
-                ""
-            };
+            let apart = if is_apart { ", not driven: apart" } else { "" };
             *flags_by
                 .entry(format!("{key}: {} (sliding μ_s {mu}{apart})", f.flag))
                 .or_default() += 1;

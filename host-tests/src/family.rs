@@ -84,19 +84,18 @@ pub fn draw_form(scene: &mut Scene, rng: &mut Rng) {
     scene.noise.current_offset_a = offset;
 }
 
-/// The family examples' leading `[RUNS] [SEED]` arguments, each defaulted when absent; a value
-/// that is not a number is an error naming it.
-pub fn runs_and_seed(
-    args: &mut impl Iterator<Item = String>,
-    runs: u64,
-    seed: u64,
-) -> Result<(u64, u64), String> {
-    let mut next = |default: u64, name: &str| {
-        args.next()
-            .map_or(Ok(default), |s| s.parse())
-            .map_err(|e| format!("{name}: {e}"))
+/// The examples' leading `[RUNS] [SEED]` arguments, each defaulted when absent. A value that is
+/// not a whole number ends the program with one line naming it and exit code 2, as the xtask's
+/// commands do.
+pub fn runs_and_seed(args: &mut impl Iterator<Item = String>, runs: u64, seed: u64) -> (u64, u64) {
+    let mut next = |default: u64, name: &str| match args.next() {
+        None => default,
+        Some(s) => s.parse().unwrap_or_else(|e| {
+            eprintln!("error: {name} '{s}' is not a whole number ({e})");
+            std::process::exit(2)
+        }),
     };
-    Ok((next(runs, "RUNS")?, next(seed, "SEED")?))
+    (next(runs, "RUNS"), next(seed, "SEED"))
 }
 
 #[cfg(test)]
