@@ -26,6 +26,7 @@ R, R_MS, R_MD, R_MR = 0.02, 0.012, 0.01, 0.01
 R1, R2, GP1, GP2 = 0.0285, 0.0375, 0.2e-3, 0.5e-3
 THETA, NF, MU_S, MU_D, E = math.pi / 4, 3, 0.3, 0.17, 0.5
 G = 9.81
+TOUCH_EVENT_M = 1e-15
 RECORD_ALL = False  # set from the command line
 FLOOR = 0.01          # approach-speed floor (m/s)
 KP = 50.0             # servo gain (N m s/rad)
@@ -124,7 +125,9 @@ class Model:
         return self.eval(y)[0]
 
     def event_values(self, y):
-        g = [self.pen(c, y)[0] for c in CONTACTS]
+        # As the twin: a contact's event fires at 1e-15 m, not at 0 (a contact seated at zero
+        # penetration within rounding would fire at every step).
+        g = [self.pen(c, y)[0] - TOUCH_EVENT_M for c in CONTACTS]
         _, fp, _, req, cap_s, cap_d = self.eval(y)
         if self.mode in (FWD, BWD):
             g.append(y[TC + 1])

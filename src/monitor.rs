@@ -340,6 +340,7 @@ impl Monitor {
             slot,
             drive_drag: k.pack.drive_drag,
             min_load: k.scene.min_load,
+            settle_ticks: k.scene.engage_settle_ticks,
         };
         let (raised, gave_way) =
             st.checks

@@ -1,6 +1,6 @@
 //! Where the uncommissioned monitor false-alarms on the plant family (docs/decisions.md, "The
 //! plant family in the Monte Carlo"): the healthy runs of `monitor-mc --family plant`, per
-//! form and scene kind, with the first flag each raised and whether the paper reading's pack
+//! form and scene kind, with the first flag each raised, the runs that raised it, and whether the paper reading's pack
 //! slips at μ_s.
 //!
 //! `cargo run --release -p host-tests --example family_false_alarms -- [RUNS] [SEED]` (defaults
@@ -15,7 +15,7 @@ fn main() -> Result<(), String> {
     let mut args = std::env::args().skip(1);
     let (runs, seed) = runs_and_seed(&mut args, 400, 1616);
     let mut runs_by: BTreeMap<String, usize> = BTreeMap::new();
-    let mut flags_by: BTreeMap<String, usize> = BTreeMap::new();
+    let mut flags_by: BTreeMap<String, Vec<u64>> = BTreeMap::new();
     let (mut apart, mut apart_quiet) = (0, 0);
     for i in 0..runs {
         let d = draw_in(Family::Plant, seed, i, None);
@@ -31,9 +31,10 @@ fn main() -> Result<(), String> {
         if let Some(f) = acc.flags.first() {
             let mu = d.scene.open.paper_sliding_mu_static;
             let apart = if is_apart { ", not driven: apart" } else { "" };
-            *flags_by
+            flags_by
                 .entry(format!("{key}: {} (sliding μ_s {mu}{apart})", f.flag))
-                .or_default() += 1;
+                .or_default()
+                .push(i);
         }
     }
     println!("healthy runs {runs} of seed {seed}, by form and scene kind:");
@@ -42,8 +43,8 @@ fn main() -> Result<(), String> {
     }
     println!("input apart from output (counted apart): {apart}, of which no flag: {apart_quiet}");
     println!("false alarms by first flag:");
-    for (k, n) in &flags_by {
-        println!("{n:6}  {k}");
+    for (k, runs) in &flags_by {
+        println!("{:6}  {k}: runs {runs:?}", runs.len());
     }
     Ok(())
 }

@@ -82,6 +82,8 @@ pub(crate) struct CheckInputs {
     pub slot: Slot,
     pub drive_drag: Q16,
     pub min_load: Q16,
+    /// The observer's settling after a change of the pack's reading (ticks).
+    pub settle_ticks: u32,
 }
 
 /// The checks' state.
@@ -219,6 +221,7 @@ impl Checks {
                     load_ref: load.reference,
                     pending: c.pending,
                     ticks: x.n,
+                    settle_ticks: i.settle_ticks,
                 };
                 raised = raised.union(self.drive.run(&k.drive, &t));
             } else {

@@ -115,6 +115,9 @@ pub(crate) struct DriveChecks {
     /// `brake_drag` is no longer raised from it until the flags are reset (a drag read from a
     /// reading known to be wrong would send maintenance to the brake). Kept across `disarm`.
     current_suspect: bool,
+    /// Ticks the drag check still waits after a pending change of reading ended: the
+    /// observer's net torque carries the pack's pulse for its settling time.
+    drag_wait_ticks: u32,
 }
 
 /// What the step knows of this tick.
@@ -139,6 +142,8 @@ pub(crate) struct DriveTick {
     pub pending: bool,
     /// Ticks since the previous step.
     pub ticks: u32,
+    /// The observer's settling after a change of the pack's reading (`engage_settle_s`).
+    pub settle_ticks: u32,
 }
 
 impl DriveChecks {
@@ -272,7 +277,13 @@ impl DriveChecks {
         }
         // Drag against the drive's start: the load the current implies with a nominal drag
         // beyond the envelope, or the pack torque beyond the reference load by the allowance.
-        if t.carrying && !t.pending {
+        // It waits the observer's settling after a pending change (continuous closing's chatter).
+        self.drag_wait_ticks = if t.pending {
+            t.settle_ticks
+        } else {
+            self.drag_wait_ticks.saturating_sub(counted)
+        };
+        if t.carrying && !t.pending && self.drag_wait_ticks == 0 {
             let implied = t.net.saturating_add(t.dir.apply(p.drive_drag)); // load if drag nominal
             let over_model = implied.saturating_abs() > p.max_load;
             let excess = t
@@ -321,6 +332,7 @@ mod tests {
             load_ref: None,
             pending,
             ticks: 1,
+            settle_ticks: settings().scene.engage_settle_ticks,
         }
     }
 
@@ -358,6 +370,24 @@ mod tests {
         run(&mut c, &carrying(20.0, false), 100);
         let f = run(&mut c, &carrying(15.0, false), 26);
         assert!(f.sensor_fault && !f.brake_drag, "{f:?}");
+    }
+
+    #[test]
+    fn the_drag_check_waits_the_observers_settling_after_a_pending_change() {
+        // The pack torque 12 N·m beyond the load at the drive's start (limit: drag + 8 N·m).
+        let mut dragging = carrying(2.0, false);
+        dragging.load_ref = Some(dragging.net.saturating_add(Q16::from_num(12.0)));
+        let pending = DriveTick {
+            pending: true,
+            ..dragging
+        };
+        let mut c = DriveChecks::default();
+        assert!(run(&mut c, &dragging, 26).brake_drag, "25 runs persist");
+        let mut c = DriveChecks::default();
+        run(&mut c, &pending, 10);
+        // 20 ms of settling (50 runs), then 10 ms of persistence (25 runs).
+        assert!(!run(&mut c, &dragging, 73).brake_drag);
+        assert!(run(&mut c, &dragging, 1).brake_drag);
     }
 
     #[test]
