@@ -1,7 +1,7 @@
 //! Where the uncommissioned monitor false-alarms on the plant family (docs/decisions.md, "The
 //! plant family in the Monte Carlo"): the healthy runs of `monitor-mc --family plant`, per
-//! form and scene kind, with the first flag each raised, the runs that raised it, and whether the paper reading's pack
-//! slips at μ_s.
+//! form and scene kind, with the first flag each raised, the runs that raised it, and whether
+//! the paper reading's pack slips at μ_s.
 //!
 //! `cargo run --release -p host-tests --example family_false_alarms -- [RUNS] [SEED]` (defaults
 //! 400 and 1616).

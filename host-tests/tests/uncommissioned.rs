@@ -8,11 +8,13 @@
 //! (docs/decisions.md). A plant whose input comes apart from its output (the paper
 //! reading's closing at loads up to 8 N·m) is not healthy: the monitor must flag it.
 
-use host_tests::accuracy::{compare, run_monitor, scene_trace};
-use host_tests::mc::not_driven;
+use host_tests::accuracy::{compare, run_monitor, scene_trace, Accuracy};
+use host_tests::family::Family;
+use host_tests::mc::{draw_in, draw_trace, not_driven, Draw};
 use noback::monitor::{Config, Thresholds};
 use noback_twin::reading::Reading;
 use noback_twin::scene::{Scene, SceneKind};
+use noback_twin::trace::Trace;
 
 const KINDS: [SceneKind; 5] = [
     SceneKind::ReverseLoad,
@@ -22,10 +24,19 @@ const KINDS: [SceneKind; 5] = [
     SceneKind::Drive,
 ];
 
+/// Healthy draw `run` of the plant family at `seed`, and its twin trace.
+fn family_draw(seed: u64, run: u64) -> (Draw, Trace) {
+    let d = draw_in(Family::Plant, seed, run, None);
+    let trace = draw_trace(&d).expect("twin");
+    (d, trace)
+}
+
 /// What the family's uncommissioned monitor makes of a draw's trace.
-fn family_monitor(trace: &noback_twin::trace::Trace) -> host_tests::accuracy::Accuracy {
-    let config = host_tests::family::Family::Plant.config();
-    compare(trace, &run_monitor(trace, config).expect("monitor"))
+fn family_monitor(trace: &Trace) -> Accuracy {
+    compare(
+        trace,
+        &run_monitor(trace, Family::Plant.config()).expect("monitor"),
+    )
 }
 
 #[test]
@@ -90,10 +101,7 @@ fn the_physical_readings_settings_tighten_only_the_family_wide_limits() {
 /// slows it; the creep check allowed that span only while the output decelerates.
 #[test]
 fn a_load_turning_the_output_back_until_the_ramps_clamp_is_no_slip() {
-    use host_tests::family::Family;
-    use host_tests::mc::{draw_in, draw_trace};
-    let d = draw_in(Family::Plant, 1616, 2875, None);
-    let trace = draw_trace(&d).expect("twin");
+    let (_, trace) = family_draw(1616, 2875);
     let start = trace
         .rows
         .iter()
@@ -119,11 +127,8 @@ fn a_load_turning_the_output_back_until_the_ramps_clamp_is_no_slip() {
 /// envelope allows 4×, so this healthy plant raises nothing.
 #[test]
 fn a_pack_braking_at_a_third_of_the_model_is_not_weak_uncommissioned() {
-    use host_tests::family::Family;
-    use host_tests::mc::{draw_in, draw_trace};
-    let d = draw_in(Family::Plant, 1616, 791, None);
+    let (d, trace) = family_draw(1616, 791);
     assert!(d.scene.faults.is_empty());
-    let trace = draw_trace(&d).expect("twin");
     let cut = trace.rows.iter().position(|r| !r.drive_on).expect("a cut");
     let from = trace.rows[cut].output_angle_rad;
     let travel = trace.rows[cut..]
@@ -156,10 +161,7 @@ fn a_pack_braking_at_a_third_of_the_model_is_not_weak_uncommissioned() {
 /// still output of any healthy draw of that seed's first 10 000, is a healthy plant.
 #[test]
 fn an_input_that_comes_apart_from_its_output_is_counted_apart_and_flagged() {
-    use host_tests::family::Family;
-    use host_tests::mc::{draw_in, draw_trace};
-    let d = draw_in(Family::Plant, 1616, 5115, None);
-    let trace = draw_trace(&d).expect("twin");
+    let (d, trace) = family_draw(1616, 5115);
     assert!(not_driven(&trace, &d.scene.sensors));
     let acc = family_monitor(&trace);
     assert!(
@@ -167,11 +169,8 @@ fn an_input_that_comes_apart_from_its_output_is_counted_apart_and_flagged() {
         "{:?}",
         acc.flag_times()
     );
-    let d = draw_in(Family::Plant, 1616, 8289, None);
-    assert!(!not_driven(
-        &draw_trace(&d).expect("twin"),
-        &d.scene.sensors
-    ));
+    let (d, trace) = family_draw(1616, 8289);
+    assert!(!not_driven(&trace, &d.scene.sensors));
 }
 
 /// Tuning seed 4242's run 3716 (physical form, continuous closing at 5.4 N·m with a
@@ -180,10 +179,7 @@ fn an_input_that_comes_apart_from_its_output_is_counted_apart_and_flagged() {
 /// to wait the observer's settling after a pending change of reading.
 #[test]
 fn continuous_closings_chatter_at_a_light_load_and_a_soft_servo_is_no_drag() {
-    use host_tests::family::Family;
-    use host_tests::mc::{draw_in, draw_trace};
-    let d = draw_in(Family::Plant, 4242, 3716, None);
-    let trace = draw_trace(&d).expect("twin");
+    let (_, trace) = family_draw(4242, 3716);
     let acc = family_monitor(&trace);
     assert!(acc.flags.is_empty(), "{:?}", acc.flag_times());
 }
@@ -193,9 +189,6 @@ fn continuous_closings_chatter_at_a_light_load_and_a_soft_servo_is_no_drag() {
 /// ("events fire without time advancing"). A contact's event now fires at 1e-15 m.
 #[test]
 fn a_contact_seated_at_zero_penetration_does_not_stop_the_twin() {
-    use host_tests::family::Family;
-    use host_tests::mc::{draw_in, draw_trace};
-    let d = draw_in(Family::Plant, 7, 9297, None);
-    let trace = draw_trace(&d).expect("the twin runs the draw through");
+    let (_, trace) = family_draw(7, 9297);
     assert!(!trace.rows.is_empty());
 }
