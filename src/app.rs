@@ -15,7 +15,8 @@ use crate::event_log::{Event, EventLog};
 use crate::monitor::{Estimate, Flags, Inputs, Monitor};
 use embedded_hal::digital::OutputPin;
 
-/// Events the log holds between two drains of the main loop.
+/// Events the log holds between two drains of the main loop (the default; an image whose logger
+/// drains faster than semihosting may hold fewer).
 pub const LOG_CAPACITY: usize = 32;
 
 /// A state line every this many ticks (100 Hz at 10 kHz).
@@ -28,12 +29,12 @@ pub fn estimate_checksum(estimate: &Estimate) -> u32 {
     estimate.to_words().last().copied().unwrap_or(0)
 }
 
-/// The tick's state: monitor, sensors, alarm, log, counters.
-pub struct Ticker<S, P> {
+/// The tick's state: monitor, sensors, alarm, a log of `N` events, counters.
+pub struct Ticker<S, P, const N: usize = LOG_CAPACITY> {
     monitor: Monitor,
     source: S,
     alarm: P,
-    log: EventLog<LOG_CAPACITY>,
+    log: EventLog<N>,
     last_flags: Flags,
     ticks: u32,
     overruns: u32,
@@ -63,8 +64,10 @@ pub struct Totals {
     pub digest: u32,
 }
 
-impl<S: SampleSource, P: OutputPin> Ticker<S, P> {
-    /// Starts with the alarm off.
+impl<S: SampleSource, P: OutputPin, const N: usize> Ticker<S, P, N> {
+    /// Starts with the alarm off. Inlined, so a caller writing it into a static builds the
+    /// monitor there (the part's init stack).
+    #[inline(always)]
     pub fn new(monitor: Monitor, source: S, mut alarm: P) -> Self {
         let alarm_errors = u32::from(alarm.set_low().is_err());
         Ticker {

@@ -93,7 +93,7 @@ use pack::Dir;
 use scene::{Classified, Classify};
 use schedule::{Slot, WINDOW};
 use sense::{Sense, Sensed};
-use settings::Settings;
+pub use settings::Settings;
 
 /// Largest capacity margin reported (loads below `min_load_nm` report this).
 pub const MARGIN_MAX: Q16 = Q16::from_bits(1000 << 16);
@@ -168,9 +168,13 @@ impl Monitor {
         Ok(Monitor::with_settings(Settings::new(&config)?))
     }
 
-    /// A monitor at power-on on settings already converted (a configuration block's).
-    fn with_settings(settings: Settings) -> Monitor {
-        let mut monitor = Monitor {
+    /// A monitor at power-on on settings already converted (a configuration block's). Inlined,
+    /// so a caller writing it into a static builds it there (the part's init stack).
+    #[inline(always)]
+    pub fn with_settings(settings: Settings) -> Monitor {
+        let mut load = Load::new();
+        refresh_load(&mut load, &settings);
+        Monitor {
             settings,
             state: State {
                 tick: 0,
@@ -179,7 +183,7 @@ impl Monitor {
                 classify: Classify::new(),
                 classified: Classified::NONE,
                 observed: Observed::NONE,
-                load: Load::new(),
+                load,
                 estimate: Estimate::NONE,
                 energy: Energy::new(),
                 checks: Checks::new(),
@@ -194,9 +198,7 @@ impl Monitor {
                 o: Observed::NONE,
             },
             job_due: false,
-        };
-        monitor.state.refresh_load(&monitor.settings);
-        monitor
+        }
     }
 
     /// The model this monitor runs in `scene` (the cheapest per scene,
@@ -494,13 +496,7 @@ impl State {
 
     /// The load cache for the present load (its reciprocal and products).
     fn refresh_load(&mut self, k: &Settings) {
-        let load = self.load.estimate.value();
-        let capacity = k.pack.capacity(k.pack.clamped_force(load));
-        let decel = k
-            .checks
-            .envelope
-            .decelerations(capacity, load, self.load.alt);
-        self.load.refresh(&k.load, load, capacity, decel);
+        refresh_load(&mut self.load, k);
     }
 
     /// The estimate of this tick: the last classification's, with this tick's count, energy,
@@ -519,6 +515,14 @@ impl State {
             ..self.estimate
         }
     }
+}
+
+/// `load`'s cache for its present load (its reciprocal and products).
+fn refresh_load(load: &mut Load, k: &Settings) {
+    let value = load.estimate.value();
+    let capacity = k.pack.capacity(k.pack.clamped_force(value));
+    let decel = k.checks.envelope.decelerations(capacity, value, load.alt);
+    load.refresh(&k.load, value, capacity, decel);
 }
 
 #[cfg(test)]

@@ -55,7 +55,7 @@ mod target {
                 black_box(());
             }
         };
-        let mut ticker = Ticker::new(monitor, Opaque, Pin);
+        let mut ticker: Ticker<_, _> = Ticker::new(monitor, Opaque, Pin);
         loop {
             black_box(ticker.tick(black_box(1)));
             ticker.background();

@@ -143,7 +143,7 @@ mod target {
         if args.bench {
             session::run_bench(replay, stream, monitor, peripherals.SYST)
         } else {
-            let mut app = Ticker::new(monitor, replay, AlarmPin { high: false });
+            let mut app: App = Ticker::new(monitor, replay, AlarmPin { high: false });
             app.request_functional_test_at(args.functional_test_at);
             run_realtime(
                 app,

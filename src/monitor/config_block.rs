@@ -48,17 +48,22 @@ pub fn encode(c: &Config, buf: &mut [u8]) -> Result<usize, ConfigBlockError> {
 
 /// The monitor at power-on on a block's settings (trailing bytes after it are ignored).
 pub fn decode(bytes: &[u8]) -> Result<Monitor, ConfigBlockError> {
+    read(bytes, |s| Monitor::with_settings(*s))
+}
+
+/// `f` of a block's settings (trailing bytes after it are ignored). `f` runs where they were
+/// decoded, so a firmware builds its monitor in a static with one copy of them on the stack.
+#[inline(always)]
+pub fn read<T>(bytes: &[u8], f: impl FnOnce(&Settings) -> T) -> Result<T, ConfigBlockError> {
     let (head, body) = bytes.split_at_checked(4).ok_or(ConfigBlockError::Size)?;
     if head != CONFIG_BLOCK_MAGIC {
         return Err(ConfigBlockError::Magic);
     }
-    let settings: Settings = postcard::take_from_bytes_crc32(body, CRC.digest())
-        .map(|(s, _)| s)
-        .map_err(|e| match e {
-            postcard::Error::DeserializeUnexpectedEnd => ConfigBlockError::Size,
-            _ => ConfigBlockError::Corrupt,
-        })?;
-    Ok(Monitor::with_settings(settings))
+    match postcard::take_from_bytes_crc32::<Settings>(body, CRC.digest()) {
+        Ok((settings, _)) => Ok(f(&settings)),
+        Err(postcard::Error::DeserializeUnexpectedEnd) => Err(ConfigBlockError::Size),
+        Err(_) => Err(ConfigBlockError::Corrupt),
+    }
 }
 
 #[cfg(test)]

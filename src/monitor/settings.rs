@@ -12,27 +12,27 @@ use super::pack::PackSettings;
 use super::scene::SceneSettings;
 use super::sense::SenseSettings;
 
-/// Every stage's settings.
+/// Every stage's settings, converted from a [`Config`] (or read from a configuration block).
 #[cfg_attr(
     feature = "config-block",
     derive(serde::Serialize, serde::Deserialize, Hash)
 )]
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub(crate) struct Settings {
-    pub sense: SenseSettings,
-    pub observe: ObserveSettings,
-    pub pack: PackSettings,
-    pub scene: SceneSettings,
-    pub load: LoadSettings,
-    pub estimate: EstimateSettings,
-    pub checks: CheckSettings,
-    pub functional_test: TestSettings,
+pub struct Settings {
+    pub(crate) sense: SenseSettings,
+    pub(crate) observe: ObserveSettings,
+    pub(crate) pack: PackSettings,
+    pub(crate) scene: SceneSettings,
+    pub(crate) load: LoadSettings,
+    pub(crate) estimate: EstimateSettings,
+    pub(crate) checks: CheckSettings,
+    pub(crate) functional_test: TestSettings,
     /// No estimate is trusted unless the monitor was set for its plant.
-    pub commissioned: bool,
+    pub(crate) commissioned: bool,
 }
 
 impl Settings {
-    pub fn new(c: &Config) -> Result<Settings, ConfigError> {
+    pub(crate) fn new(c: &Config) -> Result<Settings, ConfigError> {
         let tick_hz = positive(c.tick_hz, "tick_hz")?;
         require((100.0..=1.0e6).contains(&tick_hz), "tick_hz")?;
         let max_load = positive(c.thresholds.max_load_nm, "thresholds.max_load_nm")?;

@@ -121,7 +121,7 @@ pub fn host_run_tested(
 ) -> Result<HostRun, String> {
     let replay = Replay::parse(bytes).map_err(|e| format!("replay: {e:?}"))?;
     let monitor = Monitor::new(config).map_err(|e| format!("monitor: {e:?}"))?;
-    let mut ticker = Ticker::new(monitor, replay, HostPin::default());
+    let mut ticker: Ticker<_, _> = Ticker::new(monitor, replay, HostPin::default());
     if let Some(at) = test_at {
         ticker.request_functional_test_at(at);
     }

@@ -22,6 +22,9 @@ use thumb::scan;
 /// exception entry stacks, and the fault handler (terminal, reported apart).
 pub struct Contexts {
     pub thread: &'static str,
+    /// The thread's init, if it runs with interrupts masked until it returns (RTIC's resource
+    /// init: checked in the code, else ignored): handlers stack on its frame, not its callees'.
+    pub masked_init: Option<&'static str>,
     pub handlers: &'static [&'static str],
     pub entry_bytes: u32,
     pub fault: &'static str,
@@ -32,6 +35,7 @@ pub struct Contexts {
 /// 4 B of padding when SP was not 8-byte aligned.
 pub const FLIGHT: Contexts = Contexts {
     thread: "Reset",
+    masked_init: Some("::__rtic_init_resources"),
     handlers: &["USART6", "TIM3"],
     entry_bytes: 104 + 4,
     fault: "HardFault",
@@ -46,6 +50,8 @@ struct Func {
     unresolved: Vec<String>,
     dynamic: bool,
     panic: bool,
+    masked_calls: Vec<usize>,
+    unmasks_last: bool,
 }
 
 /// One root's bound, or what withholds it (unresolved indirect calls, recursion, SP set from a
@@ -65,6 +71,8 @@ pub struct Depth {
 #[derive(Debug)]
 pub struct Report {
     pub thread: Depth,
+    /// The thread once interrupts open: the masked init a leaf (its callees returned).
+    pub after_init: Option<Depth>,
     /// From lowest priority to highest.
     pub handlers: Vec<Depth>,
     pub entry_bytes: u32,
@@ -77,11 +85,16 @@ impl Report {
         std::iter::once(&self.thread).chain(&self.handlers)
     }
 
-    /// Thread, each handler and one exception entry per handler, if all are bounded.
+    /// The thread with interrupts masked, or the thread once they open plus each handler and
+    /// one exception entry per handler, whichever is deeper, if all are bounded.
     pub fn total(&self) -> Option<u32> {
         let entries = self.handlers.len() as u32 * self.entry_bytes;
-        let sum: Option<u32> = self.roots().map(|d| d.bytes).sum();
-        sum.map(|b| b + entries)
+        let open = self.after_init.as_ref().unwrap_or(&self.thread);
+        let sum: Option<u32> = std::iter::once(open)
+            .chain(&self.handlers)
+            .map(|d| d.bytes)
+            .sum();
+        sum.map(|b| (b + entries).max(self.thread.bytes.unwrap_or(0)))
     }
 
     /// Unresolved indirect calls on the roots' graphs, panic paths cut.
@@ -153,6 +166,8 @@ pub fn bound_with(elf: &str, ctx: &Contexts) -> Result<Report, String> {
             frame,
             dynamic,
             panic,
+            masked_calls: s.masked_calls.iter().filter_map(|&t| index(t)).collect(),
+            unmasks_last: s.unmasks_last,
             ..Func::default()
         };
         for t in s.calls {
@@ -172,7 +187,7 @@ pub fn bound_with(elf: &str, ctx: &Contexts) -> Result<Report, String> {
         }
         funcs.push(f);
     }
-    let root = |label: &str| {
+    let root = |label: &str, funcs: &[Func]| {
         let mut d = Depth {
             label: label.to_string(),
             ..Depth::default()
@@ -182,7 +197,7 @@ pub fn bound_with(elf: &str, ctx: &Contexts) -> Result<Report, String> {
             return d;
         };
         let mut marks = vec![Mark::New; funcs.len()];
-        d.bytes = walk(&funcs, at, true, &mut marks, &mut Vec::new(), &mut d);
+        d.bytes = walk(funcs, at, true, &mut marks, &mut Vec::new(), &mut d);
         while let (Mark::Done(Some(_), next), true) = (marks[at], d.bytes.is_some()) {
             d.path.push((funcs[at].name.clone(), funcs[at].frame));
             let Some(next) = next else { break };
@@ -206,16 +221,40 @@ pub fn bound_with(elf: &str, ctx: &Contexts) -> Result<Report, String> {
         list.sort_unstable();
         list.dedup();
     }
-    let (thread, fault) = (root(ctx.thread), root(ctx.fault));
-    let handlers = ctx.handlers.iter().map(|h| root(h)).collect();
+    let (thread, fault) = (root(ctx.thread, &funcs), root(ctx.fault, &funcs));
+    let handlers = ctx.handlers.iter().map(|h| root(h, &funcs)).collect();
+    let after_init = ctx
+        .masked_init
+        .and_then(|suffix| funcs.iter().position(|f| f.name.ends_with(suffix)))
+        .filter(|&i| runs_masked(&funcs, i))
+        .map(|i| {
+            let mut leaf = funcs;
+            leaf[i].callees.clear();
+            let mut d = root(ctx.thread, &leaf);
+            d.label = format!("{} after {}", ctx.thread, leaf[i].name);
+            d
+        });
     let entry_bytes = ctx.entry_bytes;
     Ok(Report {
         thread,
+        after_init,
         handlers,
         entry_bytes,
         fault,
         panic,
     })
+}
+
+/// Whether `init` runs with interrupts masked until it returns: every caller masks them in
+/// straight-line code before the call, and each unmasking in `init` goes straight to its return.
+fn runs_masked(funcs: &[Func], init: usize) -> bool {
+    let mut callers = funcs
+        .iter()
+        .filter(|f| f.callees.contains(&init))
+        .peekable();
+    funcs[init].unmasks_last
+        && callers.peek().is_some()
+        && callers.all(|f| f.masked_calls.contains(&init))
 }
 
 /// The panic entry points: their paths format through vtables.
@@ -298,11 +337,18 @@ impl fmt::Display for Depth {
 
 impl fmt::Display for Report {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        let roots: Vec<String> = self.roots().map(|d| d.to_string()).collect();
+        let open = self.after_init.as_ref().unwrap_or(&self.thread);
+        let roots: Vec<String> = std::iter::once(open)
+            .chain(&self.handlers)
+            .map(|d| d.to_string())
+            .collect();
         let (roots, n, entry) = (roots.join(" + "), self.handlers.len(), self.entry_bytes);
         match self.total() {
             Some(t) => write!(f, "Stack bound {t} B = ")?,
             None => write!(f, "No stack bound: ")?,
+        }
+        if self.after_init.is_some() {
+            write!(f, "the deeper of {} (interrupts masked) and ", self.thread)?;
         }
         write!(
             f,
@@ -391,6 +437,7 @@ mod tests {
         println!("{}", bound(&flight.to_string_lossy()).unwrap());
         let m3 = Contexts {
             thread: "Reset",
+            masked_init: None,
             handlers: &["PendSV", "SysTick"],
             entry_bytes: 32 + 4,
             fault: "HardFault",

@@ -4,6 +4,13 @@
 
 use crate::app::App;
 
+/// Events the tick's log holds until the idle loop drains it: semihosting is slow under QEMU;
+/// RTT takes each within microseconds on a part, whose RAM budget is 4 KB (issue 15).
+#[cfg(feature = "qemu")]
+pub const LOG_EVENTS: usize = noback::app::LOG_CAPACITY;
+#[cfg(feature = "hw")]
+pub const LOG_EVENTS: usize = 8;
+
 /// The tick's sample source under QEMU: the twin's trace, streamed from the host.
 #[cfg(feature = "qemu")]
 pub type Source = noback::replay::Streamed<'static>;

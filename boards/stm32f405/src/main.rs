@@ -33,9 +33,12 @@ mod io;
 #[rtic::app(device = stm32f4xx_hal::pac, dispatchers = [USART6])]
 mod app {
     use crate::clock::{self, TIMER_HZ};
+    use core::mem::MaybeUninit;
     use cortex_m::peripheral::SYST;
     use fugit::TimerDurationU32;
     use noback::app::Ticker;
+    #[cfg(feature = "hw")]
+    use noback::monitor::{config_block, Monitor};
     use stm32f4xx_hal::gpio::{Output, PA10};
     use stm32f4xx_hal::pac;
     use stm32f4xx_hal::prelude::*;
@@ -46,11 +49,12 @@ mod app {
     use noback::platform::session;
 
     /// The application: the monitor's tick with its sample source and alarm pin.
-    pub type App = Ticker<io::Source, PA10<Output>>;
+    pub type App = Ticker<io::Source, PA10<Output>, { io::LOG_EVENTS }>;
 
     #[shared]
     struct Shared {
-        app: App,
+        /// Built in place in `init`'s slot (a moved copy would double init's stack).
+        app: &'static mut App,
         timer: Counter<pac::TIM3, TIMER_HZ>,
         /// The last tick's slow-lane work has not finished yet.
         background_due: bool,
@@ -73,7 +77,7 @@ mod app {
         reset_every: u32,
     }
 
-    #[init]
+    #[init(local = [app_slot: MaybeUninit<App> = MaybeUninit::uninit()])]
     fn init(cx: init::Context) -> (Shared, Local) {
         let dp = cx.device;
         let mut rcc = clock::setup(dp.RCC);
@@ -82,7 +86,11 @@ mod app {
             let args = session::args();
             session::self_check();
             let (stream, replay) = session::open(&args);
-            let resident = crate::config_sector::monitor();
+            let (block, from) = crate::config_sector::block();
+            let Ok(monitor) = noback::monitor::config_block::decode(block) else {
+                clock::halt("the configuration block does not decode")
+            };
+            let resident = (monitor, from);
             let monitor = session::monitor(&replay, &args, "STM32F405", Some(resident));
             if args.bench {
                 session::run_bench(replay, stream, monitor, cx.core.SYST)
@@ -91,7 +99,7 @@ mod app {
         };
         let gpioa = dp.GPIOA.split(&mut rcc);
         #[cfg(feature = "hw")]
-        let (stream, source, monitor) = {
+        let (stream, source) = {
             let gpiob = dp.GPIOB.split(&mut rcc);
             let wiring = crate::sensors::Wiring {
                 adc: (dp.ADC1, gpioa.pa3),
@@ -101,7 +109,16 @@ mod app {
             };
             crate::sensors::setup(&mut rcc, wiring)
         };
-        let app = Ticker::new(monitor, source, gpioa.pa10.into_push_pull_output());
+        let alarm = gpioa.pa10.into_push_pull_output();
+        // The monitor is built in its static slot: a copy on init's stack would double it.
+        #[cfg(feature = "hw")]
+        let app = {
+            let (block, from) = crate::config_sector::block();
+            defmt::info!("noback firmware on STM32F405: configuration {=str}", from);
+            install(cx.local.app_slot, block, source, alarm)
+        };
+        #[cfg(feature = "qemu")]
+        let app = cx.local.app_slot.write(Ticker::new(monitor, source, alarm));
         // SysTick runs free on the core clock: the meter of each tick's time used.
         clock::start_meter(cx.core.SYST);
         let mut timer = dp.TIM3.counter::<TIMER_HZ>(&mut rcc);
@@ -136,6 +153,26 @@ mod app {
                 reset_every: 0,
             },
         )
+    }
+
+    /// Builds the application in `slot` on `block`'s settings, where they were decoded: one copy
+    /// of them on the stack, none of the monitor (the part's stack budget).
+    #[cfg(feature = "hw")]
+    #[inline(never)]
+    fn install(
+        slot: &'static mut MaybeUninit<App>,
+        block: &[u8],
+        source: io::Source,
+        alarm: PA10<Output>,
+    ) -> &'static mut App {
+        let built = config_block::read(block, |settings| {
+            slot.write(Ticker::new(
+                Monitor::with_settings(*settings),
+                source,
+                alarm,
+            ))
+        });
+        built.unwrap_or_else(|_| clock::halt("the configuration block does not decode"))
     }
 
     /// Feeds the sample ring (under QEMU) and prints the log; at a trace's end, the summary.

@@ -6,7 +6,6 @@
 //! (`config_sector`).
 
 use noback::board::{BoardSensors, CurrentAdc, EncoderCounter};
-use noback::monitor::Monitor;
 use stm32f4xx_hal::adc::config::{AdcConfig, Continuous, SampleTime, Sequence};
 use stm32f4xx_hal::adc::Adc;
 use stm32f4xx_hal::gpio::{Input, PA0, PA1, PA3, PB0, PB6, PB7};
@@ -52,7 +51,7 @@ pub struct Wiring {
 }
 
 /// Configures the sensors and the monitor (the unit's configuration block).
-pub fn setup(rcc: &mut Rcc, w: Wiring) -> (crate::io::Stream, Sensors, Monitor) {
+pub fn setup(rcc: &mut Rcc, w: Wiring) -> (crate::io::Stream, Sensors) {
     let (adc1, pa3) = w.adc;
     let config = AdcConfig::default().continuous(Continuous::Continuous);
     let mut adc = Adc::new(adc1, true, config, rcc);
@@ -64,8 +63,6 @@ pub fn setup(rcc: &mut Rcc, w: Wiring) -> (crate::io::Stream, Sensors, Monitor) 
     let (tim5, pa0, pa1) = w.output;
     let output = Encoder(Qei::new(tim5, (pa0, pa1), rcc));
     let drive = w.drive.into_input();
-    let (monitor, source) = crate::config_sector::monitor();
-    defmt::info!("noback firmware on STM32F405: configuration {=str}", source);
     let sensors = BoardSensors::new(PhaseCurrent(adc), motor, output, drive);
-    (crate::io::Stream, sensors, monitor)
+    (crate::io::Stream, sensors)
 }

@@ -39,6 +39,8 @@ enum Op {
     It(u8),
     /// Writes these registers (a mask), nothing else followed.
     Writes(u16),
+    /// CPSIE i (true) or CPSID i (false): interrupts unmasked or masked.
+    Mask(bool),
 }
 
 fn sext(v: u32, bits: u32) -> u32 {
@@ -96,6 +98,7 @@ fn narrow(h: u16, pc: u32) -> Op {
         _ if h & 0xFF80 == 0xB080 => Op::Alloc(4 * u32::from(h & 0x7F)), // SUB SP, #imm
         _ if h & 0xFF00 == 0xBF00 && h & 0xF != 0 => Op::It(4 - (h & 0xF).trailing_zeros() as u8),
         _ if h & 0xF500 == 0xB100 => Op::Branch(pc4 + cb, true), // CBZ, CBNZ
+        _ if h & 0xFFEA == 0xB662 => Op::Mask(h & 0x10 == 0),    // CPSIE i / CPSID i
         _ if h & 0xFF00 == 0xB200 || h & 0xFF00 == 0xBA00 => Op::Writes(1 << lo),
         _ if h & 0xF000 == 0xB000 => Op::Writes(0),
         _ if h & 0xFF80 == 0x4700 && m == 14 => Op::Stop,
@@ -243,6 +246,10 @@ pub(super) struct Scan {
     pub(super) calls: Vec<u32>,
     pub(super) indirect: Vec<(u32, String, Option<Vec<u32>>)>,
     pub(super) dynamic: bool,
+    /// Targets of calls made in straight-line code after a CPSID i (interrupts masked).
+    pub(super) masked_calls: Vec<u32>,
+    /// Has a CPSIE i, and each goes straight to a return: no call after interrupts open.
+    pub(super) unmasks_last: bool,
 }
 
 /// Decodes the function at `start` (`data`: literal-pool ranges to skip; `word`: reads flash).
@@ -294,7 +301,40 @@ pub(super) fn scan(code: &[u8], start: u32, data: &[(u32, u32)], word: Word) -> 
             _ => {}
         }
     }
+    (s.masked_calls, s.unmasks_last) = masking(&insns);
     s
+}
+
+/// The calls made with interrupts masked (straight line from a CPSID i), and whether every
+/// CPSIE i runs straight to a return.
+fn masking(insns: &[Insn]) -> (Vec<u32>, bool) {
+    let (mut calls, mut masked, mut unmasks, mut in_tail) = (Vec::new(), false, 0, false);
+    for i in insns {
+        // Neither transfers control nor changes the mask (conditional or not).
+        let inert = matches!(
+            i.op,
+            Op::Alloc(_) | Op::Writes(_) | Op::Const(..) | Op::Movt(..) | Op::Mov(..)
+        ) || matches!(i.op, Op::Literal(..) | Op::FromSp(_) | Op::AddIndex(..));
+        if in_tail {
+            match i.op {
+                Op::Stop if !i.cond => in_tail = false,
+                _ if inert => {}
+                _ => return (calls, false),
+            }
+            continue;
+        }
+        match i.op {
+            Op::Mask(false) if !i.cond => masked = true,
+            Op::Mask(true) => (masked, in_tail, unmasks) = (false, true, unmasks + 1),
+            Op::Call(t) if masked && !i.cond => {
+                calls.push(t);
+                masked = false;
+            }
+            _ if inert => {}
+            _ => masked = false,
+        }
+    }
+    (calls, unmasks > 0 && !in_tail)
 }
 
 /// The values each register may hold before each instruction (MOVW/MOVT, MOV, literals).
@@ -457,5 +497,24 @@ mod tests {
         let epilogue = bytes(&[0xB580, 0x466F, 0xB082, 0x46BD, 0xBD80]);
         assert!(!scan(&epilogue, 0, &[], &|_| None).dynamic);
         assert!(scan(&bytes(&[0xB580, 0x4685, 0xBD80]), 0, &[], &|_| None).dynamic);
+    }
+
+    #[test]
+    fn calls_with_interrupts_masked_and_an_unmasking_tail_are_found() {
+        // push; cpsid i; bl (masked); cpsie i; bl (open); pop {pc}
+        let main = bytes(&[
+            0xB580, 0xB672, 0xF7FF, 0xFB5D, 0xB662, 0xF7FF, 0xFB5D, 0xBD80,
+        ]);
+        let s = scan(&main, 0x0800_2F56, &[], &|_| None);
+        assert_eq!(s.masked_calls, [0x0800_2618]);
+        assert!(!s.unmasks_last, "a call after cpsie i");
+        // strb; cpsie i; add sp, #28; pop {r7, pc}: the unmasking runs straight to the return.
+        let init = bytes(&[0xB580, 0x7001, 0xB662, 0xB007, 0xBD80]);
+        let s = scan(&init, 0x1000, &[], &|_| None);
+        assert!(s.masked_calls.is_empty() && s.unmasks_last);
+        // A branch back after the unmasking may reach calls with interrupts open.
+        let back = bytes(&[0xB580, 0x2800, 0xB662, 0xD0FC, 0xBD80]);
+        assert!(!scan(&back, 0x1000, &[], &|_| None).unmasks_last);
+        assert!(!scan(&bytes(&[0xB580, 0xBD80]), 0, &[], &|_| None).unmasks_last);
     }
 }
