@@ -192,3 +192,22 @@ fn a_contact_seated_at_zero_penetration_does_not_stop_the_twin() {
     let (_, trace) = family_draw(7, 9297);
     assert!(!trace.rows.is_empty());
 }
+
+/// Tuning seed 4242's run 2301 (paper form, forward load 15.4 N·m aiding, sliding at μ_d): the
+/// pack's self-energising at μ_d exceeds the load by little, so the door, cut at 18.8 rad/s,
+/// still turns at ≈ 2 rad/s 0.66 s later, 2.8× the model's angle. Its time stretches as its
+/// angle does; the envelope allows both the same factor, so this healthy plant raises nothing.
+#[test]
+fn a_braking_slower_in_time_as_in_angle_is_not_weak_uncommissioned() {
+    let (d, trace) = family_draw(4242, 2301);
+    assert!(d.scene.faults.is_empty());
+    let cut = trace.rows.iter().position(|r| !r.drive_on).expect("a cut");
+    let at = |s: f64| &trace.rows[cut + (s * 1e4) as usize];
+    let speed = (at(0.67).output_angle_rad - at(0.66).output_angle_rad).abs() / 0.01;
+    assert!(
+        speed > 1.0,
+        "turning at {speed:.2} rad/s 0.66 s after the cut"
+    );
+    let acc = family_monitor(&trace);
+    assert!(acc.flags.is_empty(), "{:?}", acc.flag_times());
+}

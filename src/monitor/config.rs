@@ -81,11 +81,11 @@ pub struct Thresholds {
     pub slip_input_travel_rad: f64,
     /// Turn-back that ends a shaft's run in the common-slip check (rad, each shaft's side).
     pub slip_reversal_rad: f64,
-    /// Braking envelope, time: how long the output may keep moving (drive off) after the
-    /// nominal model, started from the speed at the cut, has stopped it (s): `brake_weak`.
+    /// Braking envelope, time: how long past `braking_angle_factor` × the nominal model's stop
+    /// time (started from the speed at the cut) the output may keep braking (s): `brake_weak`.
     pub braking_grace_s: f64,
-    /// Braking envelope, angle: the output angle during braking may exceed the nominal model's
-    /// by this factor …
+    /// Braking envelope: the output's angle and time during braking may exceed the nominal
+    /// model's by this factor …
     pub braking_angle_factor: f64,
     /// … plus this allowance (rad), before `brake_weak`.
     pub braking_angle_allowance_rad: f64,

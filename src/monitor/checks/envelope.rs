@@ -1,8 +1,9 @@
 //! The braking envelope (`brake_weak`): from the drive's cut, a nominal braking model —
 //! speed decreasing at `(T_all ∓ |M̂|)/J_s`, both socket faces clamping (no faster than an
 //! opposing load allows while the load's sign is a guess) — stepped by explicit
-//! Euler in I16F16 at `braking_model_hz`, gives the speed and angle a working pack allows; the
-//! output may overrun them by the allowances. A pack that does not brake at all is caught
+//! Euler in I16F16 at `braking_model_hz`, gives the speed, angle and stop time a working pack
+//! allows; the output may overrun the angle and the time by one factor (a healthy pack slipping
+//! at μ_d brakes slower alike in both) plus their allowances. A pack that does not brake at all is caught
 //! sooner: the output going further than it would at its cut speed, undecelerated.
 //!
 //! | quantity | format | range | resolution |
@@ -117,8 +118,11 @@ pub(crate) struct Envelope {
     expected_speed: Q16,
     /// Q16 counts, saturating.
     expected_counts: i32,
-    /// Ticks moving after the nominal model stopped.
+    /// Ticks the model has run, and moving after it stopped; overdue past `(factor − 1)` × its
+    /// run + the grace (time stretches by the angle's factor).
+    model_run_ticks: u32,
     overdue_ticks: u32,
+    overdue_limit: u32,
     /// Ticks since the model's last step.
     model_ticks: u32,
     /// Travel per tick and per usual model step at the cut speed (Q16 counts).
@@ -197,10 +201,10 @@ impl Envelope {
         if self.expected_speed == Q16::ZERO {
             self.overdue_ticks = self.overdue_ticks.saturating_add(b.n);
         }
-        // Both sides < 2^47: exact in i64.
         let angle_limit =
             i64::from(k.angle_factor.apply(self.expected_counts)) + i64::from(k.angle_allowance);
-        weak || self.overdue_ticks > k.grace_ticks || i64::from(self.counts) << 16 > angle_limit
+        weak || self.overdue_ticks > self.overdue_limit
+            || i64::from(self.counts) << 16 > angle_limit
     }
 
     /// One explicit-Euler step over the ticks it covers: travel with the old speed, then the
@@ -228,10 +232,18 @@ impl Envelope {
                 times(self.free_tick, n),
             )
         };
+        self.model_run_ticks = self.model_run_ticks.saturating_add(self.model_ticks);
         self.model_ticks = 0;
         self.expected_counts = self.expected_counts.saturating_add(travel);
         self.expected_speed =
             Q16::from_bits(self.expected_speed.to_bits().saturating_sub(dv).max(0));
+        if self.expected_speed == Q16::ZERO && self.overdue_limit == 0 {
+            // The model's run stretched by the angle's factor, past its stop (≥ 0: no wrap).
+            let run = i32::try_from(self.model_run_ticks).unwrap_or(i32::MAX);
+            let stretched = k.angle_factor.apply(run).max(0).unsigned_abs();
+            let extra = stretched.saturating_sub(self.model_run_ticks);
+            self.overdue_limit = extra.saturating_add(k.grace_ticks);
+        }
         self.free_counts = self.free_counts.saturating_add(free);
         // Both sides < 2^48: exact in i64.
         i64::from(self.counts) << 16
