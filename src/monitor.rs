@@ -429,7 +429,7 @@ impl State {
         // The cache follows a changing load once per window while driving (never on a drive
         // edge); with the drive off the load is held, and so is the cache.
         if x.drive && !x.drive_edge && WINDOW.slot(self.tick) == 0 && self.load.cache_stale() {
-            self.refresh_load(k);
+            refresh_load(&mut self.load, k);
         }
         // The pack's torque is known against an opposing load only where both socket faces
         // clamp (`learn_opposed`), and not at all while the load's sign is a guess (`alt`).
@@ -492,11 +492,6 @@ impl State {
             pack_health: self.load.health,
             ..self.estimate
         };
-    }
-
-    /// The load cache for the present load (its reciprocal and products).
-    fn refresh_load(&mut self, k: &Settings) {
-        refresh_load(&mut self.load, k);
     }
 
     /// The estimate of this tick: the last classification's, with this tick's count, energy,

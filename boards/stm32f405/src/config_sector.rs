@@ -14,7 +14,7 @@ static UNCOMMISSIONED: &[u8] = include_bytes!(concat!(env!("OUT_DIR"), "/uncommi
 
 /// The unit's block and where it comes from, or `Config::default()`'s when the sector is erased
 /// (no block) or its block is refused (logged). Either leaves the monitor uncommissioned, which
-/// trusts no estimate.
+/// trusts no estimate. Out of line: this check's decoding leaves the stack before `install`'s.
 #[inline(never)]
 pub fn block() -> (&'static [u8], &'static str) {
     // SAFETY: `memory.x` places `__config_block` at the start of a 128 KiB flash sector that
