@@ -85,16 +85,20 @@ impl Report {
         std::iter::once(&self.thread).chain(&self.handlers)
     }
 
+    /// The thread once interrupts open (the whole thread unless init runs masked), then the
+    /// handlers.
+    fn open_roots(&self) -> impl Iterator<Item = &Depth> {
+        let open = self.after_init.as_ref().unwrap_or(&self.thread);
+        std::iter::once(open).chain(&self.handlers)
+    }
+
     /// The thread with interrupts masked, or the thread once they open plus each handler and
     /// one exception entry per handler, whichever is deeper, if all are bounded.
     pub fn total(&self) -> Option<u32> {
         let entries = self.handlers.len() as u32 * self.entry_bytes;
-        let open = self.after_init.as_ref().unwrap_or(&self.thread);
-        let sum: Option<u32> = std::iter::once(open)
-            .chain(&self.handlers)
-            .map(|d| d.bytes)
-            .sum();
-        sum.map(|b| (b + entries).max(self.thread.bytes.unwrap_or(0)))
+        let sum: Option<u32> = self.open_roots().map(|d| d.bytes).sum();
+        sum.zip(self.thread.bytes)
+            .map(|(open, masked)| (open + entries).max(masked))
     }
 
     /// Unresolved indirect calls on the roots' graphs, panic paths cut.
@@ -337,11 +341,7 @@ impl fmt::Display for Depth {
 
 impl fmt::Display for Report {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        let open = self.after_init.as_ref().unwrap_or(&self.thread);
-        let roots: Vec<String> = std::iter::once(open)
-            .chain(&self.handlers)
-            .map(|d| d.to_string())
-            .collect();
+        let roots: Vec<String> = self.open_roots().map(|d| d.to_string()).collect();
         let (roots, n, entry) = (roots.join(" + "), self.handlers.len(), self.entry_bytes);
         match self.total() {
             Some(t) => write!(f, "Stack bound {t} B = ")?,
@@ -427,6 +427,34 @@ mod tests {
         assert_eq!(run(0, false).0, Some(108));
         let (b, d) = run(4, true);
         assert_eq!((b, d.recursive), (None, vec!["d → d".to_string()]));
+    }
+
+    #[test]
+    fn the_bound_is_the_deeper_phase_and_none_if_either_is_unbounded() {
+        let d = |bytes| Depth {
+            bytes,
+            ..Depth::default()
+        };
+        let mut r = Report {
+            thread: d(Some(1000)),
+            after_init: Some(d(Some(200))),
+            handlers: vec![d(Some(100)), d(Some(50))],
+            entry_bytes: 10,
+            fault: d(Some(8)),
+            panic: d(None),
+        };
+        assert_eq!(r.total(), Some(1000), "init, masked, is deeper");
+        r.thread.bytes = Some(300);
+        assert_eq!(r.total(), Some(370), "idle + handlers + entries");
+        r.after_init = None;
+        assert_eq!(
+            r.total(),
+            Some(470),
+            "unchecked init: the whole thread under the handlers"
+        );
+        r.thread.bytes = None;
+        r.after_init = Some(d(Some(200)));
+        assert_eq!(r.total(), None);
     }
 
     #[test]

@@ -3,8 +3,8 @@
 //! opposing load allows while the load's sign is a guess) — stepped by explicit
 //! Euler in I16F16 at `braking_model_hz`, gives the speed, angle and stop time a working pack
 //! allows; the output may overrun the angle and the time by one factor (a healthy pack slipping
-//! at μ_d brakes slower alike in both) plus their allowances. A pack that does not brake at all is caught
-//! sooner: the output going further than it would at its cut speed, undecelerated.
+//! at μ_d brakes slower alike in both) plus their allowances. A pack that does not brake at
+//! all is caught sooner: the output going further than it would at its cut speed, undecelerated.
 //!
 //! | quantity | format | range | resolution |
 //! |---|---|---|---|
@@ -118,11 +118,11 @@ pub(crate) struct Envelope {
     expected_speed: Q16,
     /// Q16 counts, saturating.
     expected_counts: i32,
-    /// Ticks the model has run, and moving after it stopped; overdue past `(factor − 1)` × its
-    /// run + the grace (time stretches by the angle's factor).
+    /// Ticks the model ran until it stopped.
     model_run_ticks: u32,
-    overdue_ticks: u32,
-    overdue_limit: u32,
+    /// Ticks braking on past the model's stop stretched by the angle's factor (from
+    /// `−(factor − 1)·run` at the stop); overdue beyond the grace.
+    overdue_ticks: i32,
     /// Ticks since the model's last step.
     model_ticks: u32,
     /// Travel per tick and per usual model step at the cut speed (Q16 counts).
@@ -199,12 +199,13 @@ impl Envelope {
             weak |= self.model_step(k, b);
         }
         if self.expected_speed == Q16::ZERO {
-            self.overdue_ticks = self.overdue_ticks.saturating_add(b.n);
+            self.overdue_ticks = self.overdue_ticks.saturating_add_unsigned(b.n);
         }
+        // Both sides < 2^47: exact in i64.
         let angle_limit =
             i64::from(k.angle_factor.apply(self.expected_counts)) + i64::from(k.angle_allowance);
-        weak || self.overdue_ticks > self.overdue_limit
-            || i64::from(self.counts) << 16 > angle_limit
+        let overdue = i64::from(self.overdue_ticks) > i64::from(k.grace_ticks);
+        weak || overdue || i64::from(self.counts) << 16 > angle_limit
     }
 
     /// One explicit-Euler step over the ticks it covers: travel with the old speed, then the
@@ -232,21 +233,73 @@ impl Envelope {
                 times(self.free_tick, n),
             )
         };
-        self.model_run_ticks = self.model_run_ticks.saturating_add(self.model_ticks);
+        let was_moving = self.expected_speed != Q16::ZERO;
+        if was_moving {
+            self.model_run_ticks = self.model_run_ticks.saturating_add(self.model_ticks);
+        }
         self.model_ticks = 0;
         self.expected_counts = self.expected_counts.saturating_add(travel);
         self.expected_speed =
             Q16::from_bits(self.expected_speed.to_bits().saturating_sub(dv).max(0));
-        if self.expected_speed == Q16::ZERO && self.overdue_limit == 0 {
-            // The model's run stretched by the angle's factor, past its stop (≥ 0: no wrap).
+        if was_moving && self.expected_speed == Q16::ZERO {
+            // Overdue counts from the run stretched by the angle's factor (never before the stop).
             let run = i32::try_from(self.model_run_ticks).unwrap_or(i32::MAX);
-            let stretched = k.angle_factor.apply(run).max(0).unsigned_abs();
-            let extra = stretched.saturating_sub(self.model_run_ticks);
-            self.overdue_limit = extra.saturating_add(k.grace_ticks);
+            self.overdue_ticks = run.saturating_sub(k.angle_factor.apply(run)).min(0);
         }
         self.free_counts = self.free_counts.saturating_add(free);
         // Both sides < 2^48: exact in i64.
         i64::from(self.counts) << 16
             > i64::from(self.free_counts) + i64::from(k.undecelerated_allowance)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Ticks until `check` calls the output weak while braking goes on under `decel` (N·m), the
+    /// output's counter still (so only the time rule can call it).
+    fn ticks_to_weak(e: &mut Envelope, k: &EnvelopeSettings, decel: f64) -> u32 {
+        let one = Dir::of(Q16::ONE, Q16::ZERO);
+        let d = Q16::from_num(decel);
+        for tick in 1..200_000_u32 {
+            let b = BrakingTick {
+                n: 1,
+                tick,
+                d_out: 0,
+                dir: one,
+                load_dir: one,
+                decel: Decel {
+                    along: d,
+                    opposed: d,
+                },
+            };
+            if e.check(k, &b) {
+                return tick;
+            }
+        }
+        u32::MAX
+    }
+
+    #[test]
+    fn the_output_is_overdue_past_the_factor_times_the_models_stop_plus_the_grace() {
+        let k = EnvelopeSettings::new(&Config::default()).expect("default settings");
+        let factor = k.angle_factor.to_f64();
+        // Not armed (a reset mid-braking) or armed at rest: the model has no run, the grace.
+        assert_eq!(
+            ticks_to_weak(&mut Envelope::default(), &k, 10.0),
+            k.grace_ticks + 1
+        );
+        // Armed at 2 rad/s under 10 N·m: the model stops after `run` ticks.
+        let mut e = Envelope::default();
+        e.arm(&k, Q16::from_num(2.0));
+        let weak_at = ticks_to_weak(&mut e, &k, 10.0);
+        let run = e.model_run_ticks;
+        assert!(run > 100, "the model ran {run} ticks");
+        let expected = (factor * f64::from(run)).round() as u32 + k.grace_ticks + 1;
+        assert!(
+            weak_at.abs_diff(expected) <= 1,
+            "weak at {weak_at}, expected {expected}"
+        );
     }
 }
