@@ -112,7 +112,7 @@ impl<S: SampleSource, P: OutputPin, const N: usize> Ticker<S, P, N> {
         if self.ticks == self.test_at {
             self.monitor.request_functional_test();
         }
-        let estimate = self.monitor.tick(&inputs);
+        let estimate = *self.monitor.tick(&inputs);
         self.ticks = self.ticks.saturating_add(1);
         self.digest.push(estimate_checksum(&estimate));
 

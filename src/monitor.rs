@@ -15,9 +15,10 @@
 //! ```
 //!
 //! # Stages
-//! [`Monitor::tick`] (the 10 kHz interrupt) and [`Monitor::background`] (the slow lane, at a
-//! lower priority before the next tick) run them in data order; [`Monitor::step`] is both. Each
-//! stage is a settings type, built once from [`Config`] by a builder beside it, and a state type.
+//! [`Monitor::tick`] (the 10 kHz interrupt: sense, observe) and [`Monitor::background`] (the
+//! rest, at a lower priority before the next tick) run them in data order; [`Monitor::step`] is
+//! both. Each stage is a settings type, built once from [`Config`] by a builder beside it, and a
+//! state type.
 //!
 //! | stage | module | in | out |
 //! |---|---|---|---|
@@ -131,8 +132,11 @@ struct State {
     flags: Flags,
     /// A brake or sensor flag is latched (`Flags::fault`): no estimate is trusted.
     fault_latched: bool,
-    /// The last slow-lane run's results, until the next tick applies them.
-    slow: SlowResult,
+    /// The last slow-lane run's slip checks saw the held brake give way (the next run's
+    /// classification loses the hold).
+    gave_way: bool,
+    /// The last slow-lane run changed the driving reading (bumpless for the observer).
+    reading_switch: bool,
     /// The commanded functional test, from the crew's request.
     test: Option<FunctionalTest>,
 }
@@ -189,11 +193,11 @@ impl Monitor {
                 checks: Checks::new(),
                 flags: Flags::default(),
                 fault_latched: false,
-                slow: SlowResult::NONE,
+                gave_way: false,
+                reading_switch: false,
                 test: None,
             },
             job: Job {
-                slot: Slot::Free,
                 x: Sensed::NONE,
                 o: Observed::NONE,
             },
@@ -239,23 +243,24 @@ impl Monitor {
     }
 
     /// One tick on the host: [`Monitor::tick`] then [`Monitor::background`], as the target runs
-    /// them when the background work finishes before the next tick. Never panics; every output
-    /// is bounded by its format.
+    /// them. Never panics; every output is bounded by its format.
     pub fn step(&mut self, inputs: &Inputs) -> Estimate {
-        let estimate = self.tick(inputs);
+        let estimate = *self.tick(inputs);
         self.background();
         estimate
     }
 
-    /// The 10 kHz interrupt's part: sense, observe, the per-tick checks and the observer's
-    /// feed-forward; latches the flags and reports. The slow lane's results it uses are those
-    /// of the previous [`Monitor::background`].
-    pub fn tick(&mut self, inputs: &Inputs) -> Estimate {
+    /// The 10 kHz interrupt's part: sense and observe, latch what they raised, report. The
+    /// estimate is the slow lane's last, with this tick's count, trust and flags. A slow lane
+    /// that has not run since the last tick runs first: every tick's work runs once, in order.
+    pub fn tick(&mut self, inputs: &Inputs) -> &Estimate {
+        if self.job_due {
+            self.background();
+        }
         let (k, st, job) = (&self.settings, &mut self.state, &mut self.job);
-        // Schedule.
+        // Schedule: the tick count (modular on purpose).
         let n = u32::from(inputs.ticks_elapsed.max(1));
-        st.tick = st.tick.wrapping_add(n); // modular on purpose
-        job.slot = Slot::of(st.tick);
+        st.tick = st.tick.wrapping_add(n);
         // Sense and observe.
         let carrying = st.classify.scene() == Scene::Driving;
         job.x = st.sense.read(&k.sense, inputs, n, carrying);
@@ -276,15 +281,38 @@ impl Monitor {
                 )
             };
         }
+        if o.fault || n > 1 {
+            st.latch(Flags {
+                sensor_fault: o.fault,
+                overrun: n > 1,
+                ..Flags::default()
+            });
+        }
+        self.job_due = true;
+        st.report(o, k.commissioned)
+    }
+
+    /// The slow lane's work for the last [`Monitor::tick`], at a lower priority before the
+    /// next tick: the tick's events, the per-tick checks (braking envelope, creep), the
+    /// observer's feed-forward, then one slot (classify, estimate, checks, window). Its flags
+    /// are latched here; the next tick reports them. Does nothing when called twice.
+    pub fn background(&mut self) {
+        if !core::mem::take(&mut self.job_due) {
+            return;
+        }
+        let (k, st) = (&self.settings, &mut self.state);
+        let Job { ref x, ref o } = self.job;
+        let slot = Slot::of(st.tick);
+        // The tick's events: a drive edge, an implausible step.
         st.classify.tick(x, o);
         st.checks.events(&k.checks, x, o);
         if x.drive_edge && x.drive {
             st.load.drive_started();
         }
-        // Check: the braking envelope and creep.
+        // Check: the braking envelope and creep, on this tick's motion.
         let dir = Dir::of(o.w, k.scene.stick_speed);
         let braking = (st.classify.scene() == Scene::FaultBraking).then(|| BrakingTick {
-            n,
+            n: x.n,
             tick: st.tick,
             d_out: x.d_out,
             dir,
@@ -292,7 +320,7 @@ impl Monitor {
             decel: st.load.cache.decel,
         });
         let (fast, gave_way) = st.checks.every_tick(&k.checks, x, o, braking);
-        if gave_way || st.slow.gave_way {
+        if gave_way || st.gave_way {
             st.classify.lose_hold();
         }
         // The pack torque the observer's model feeds forward into the next prediction.
@@ -306,27 +334,7 @@ impl Monitor {
             o.drive_torque,
             st.load.cache.capacity,
         );
-        st.observe.set_model_torque(model, st.slow.reading_switch);
-        // Flag: the one place flags are latched.
-        let mut raised = st.slow.raised.union(fast);
-        raised.sensor_fault |= o.fault;
-        raised.overrun |= n > 1;
-        st.flags = st.flags.union(raised);
-        st.fault_latched |= raised.fault();
-        st.slow = SlowResult::NONE;
-        self.job_due = true;
-        st.report(o, k.commissioned)
-    }
-
-    /// The slow lane's work for the last [`Monitor::tick`] (one slot of classify, estimate,
-    /// checks, window), run at a lower priority before the next tick; its results reach the
-    /// next tick. Does nothing when called twice.
-    pub fn background(&mut self) {
-        if !core::mem::take(&mut self.job_due) {
-            return;
-        }
-        let (k, st) = (&self.settings, &mut self.state);
-        let Job { slot, ref x, ref o } = self.job;
+        st.observe.set_model_torque(model, st.reading_switch);
         let mut reading_switch = false;
         match slot {
             _ if x.first => {
@@ -347,49 +355,23 @@ impl Monitor {
         let (raised, gave_way) =
             st.checks
                 .slow(&k.checks, x, o, &st.observed, &st.classified, &st.load, &ci);
-        st.slow = SlowResult {
-            raised,
-            gave_way,
-            reading_switch,
-        };
+        (st.gave_way, st.reading_switch) = (gave_way, reading_switch);
+        st.latch(raised.union(fast));
         if let Some(test) = st.test.as_mut() {
             test.step(&k.functional_test, x, o.drive_torque, st.flags);
         }
     }
 }
 
-/// A tick's slow-lane work: its slot and what sensing and the observer handed on.
+/// A tick's slow-lane work: what sensing and the observer handed on.
 #[cfg_attr(
     feature = "config-block",
     derive(serde::Serialize, serde::Deserialize, Hash)
 )]
 #[derive(Clone, Copy, Debug)]
 struct Job {
-    slot: Slot,
     x: Sensed,
     o: Observed,
-}
-
-/// What the slow lane hands the next tick.
-#[cfg_attr(
-    feature = "config-block",
-    derive(serde::Serialize, serde::Deserialize, Hash)
-)]
-#[derive(Clone, Copy, Debug)]
-struct SlowResult {
-    raised: Flags,
-    /// The held brake gave way (a slip check).
-    gave_way: bool,
-    /// The driving reading changed (bumpless for the observer).
-    reading_switch: bool,
-}
-
-impl SlowResult {
-    const NONE: SlowResult = SlowResult {
-        raised: Flags::from_bits(0),
-        gave_way: false,
-        reading_switch: false,
-    };
 }
 
 impl State {
@@ -490,25 +472,30 @@ impl State {
                 self.load.cache.margin
             },
             pack_health: self.load.health,
+            friction_energy_j: self.energy.joules,
             ..self.estimate
         };
     }
 
-    /// The estimate of this tick: the last classification's, with this tick's count, energy,
-    /// trust and flags.
-    fn report(&self, o: &Observed, commissioned: bool) -> Estimate {
-        Estimate {
-            tick: self.tick,
-            friction_energy_j: self.energy.joules,
-            trusted: commissioned
-                && self.load.decided()
-                && o.settled
-                && o.sensors_ok
-                && o.in_time
-                && !self.fault_latched,
-            flags: self.flags,
-            ..self.estimate
-        }
+    /// Latches `raised`: the one place flags are latched.
+    fn latch(&mut self, raised: Flags) {
+        self.flags = self.flags.union(raised);
+        self.fault_latched |= raised.fault();
+    }
+
+    /// The estimate of this tick: the last classification's, with this tick's count, trust
+    /// and flags, written in place.
+    fn report(&mut self, o: &Observed, commissioned: bool) -> &Estimate {
+        let e = &mut self.estimate;
+        e.tick = self.tick;
+        e.trusted = commissioned
+            && self.load.decided()
+            && o.settled
+            && o.sensors_ok
+            && o.in_time
+            && !self.fault_latched;
+        e.flags = self.flags;
+        e
     }
 }
 

@@ -1,9 +1,10 @@
 //! One schedule: every rate the monitor runs at, named once, and the slot of each tick.
 //!
-//! Two lanes. The **tick** (`Config::tick_hz`, 10 kHz by default) carries what the observer
-//! needs at the sensors' pace: sensing, the observer, the pack torque its model feeds forward,
-//! and the per-tick checks (braking envelope, creep). The **slow lane** ([`SLOW`], 2.5 kHz)
-//! carries the rest, one part per slot, so that no tick carries two of the costly parts:
+//! Two priorities. The **tick** (`Config::tick_hz`, 10 kHz by default, the interrupt) senses
+//! and observes. The **background**, after every tick at a lower priority, runs that tick's
+//! events, per-tick checks (braking envelope, creep) and the pack torque the observer's model
+//! feeds forward, then the **slow lane** ([`SLOW`], 2.5 kHz), one part per slot, so that no
+//! background carries two of the costly parts:
 //!
 //! | slot (tick mod 4) | work | module |
 //! |---|---|---|

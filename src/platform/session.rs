@@ -238,6 +238,10 @@ pub fn run_bench(
         let start = meter.now();
         let estimate = monitor.tick(&inputs);
         let ticks = Meter::ticks(start, meter.now()).saturating_sub(overhead);
+        let (scene, checksum) = (
+            usize::from(estimate.scene as u8),
+            estimate_checksum(estimate),
+        );
         sum += u64::from(ticks);
         max = max.max(ticks);
         let start = meter.now();
@@ -245,7 +249,6 @@ pub fn run_bench(
         let bg = Meter::ticks(start, meter.now()).saturating_sub(overhead);
         bg_sum += u64::from(bg);
         bg_max = bg_max.max(bg);
-        let scene = usize::from(estimate.scene as u8);
         if let (Some(m), Some(at)) = (scene_max.get_mut(scene), scene_max_at.get_mut(scene)) {
             if ticks > *m {
                 *m = ticks;
@@ -253,7 +256,7 @@ pub fn run_bench(
             }
         }
         steps += 1;
-        digest.push(estimate_checksum(&estimate));
+        digest.push(checksum);
     }
     defmt::info!(
         "bench steps={=u32} ticks_sum={=u64} ticks_max={=u32} bg_ticks_sum={=u64} bg_ticks_max={=u32} overhead={=u32} stack_bytes={=u32} starved={=u32} digest={=u32:#010x}",
