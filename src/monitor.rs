@@ -479,6 +479,9 @@ impl State {
 
     /// Latches `raised`: the one place flags are latched.
     fn latch(&mut self, raised: Flags) {
+        if raised == Flags::default() {
+            return; // the common case, cheaply
+        }
         self.flags = self.flags.union(raised);
         self.fault_latched |= raised.fault();
     }

@@ -14,8 +14,8 @@
 //! 50 ms.
 
 use host_tests::accuracy::{
-    compare, detection_latency_s, manifest_time, monitor_on_scene, run_monitor, scene_trace,
-    Accuracy,
+    compare, detection_latency_s, manifest_time, monitor_on_scene, run_monitor, run_monitor_with,
+    scene_trace, Accuracy,
 };
 use noback::monitor::Config;
 use noback_twin::fault::{Fault, FaultKind};
@@ -377,4 +377,34 @@ fn worn_pack_that_opens_while_holding_manifests_and_raises_brake_slip() {
     );
     assert!(latency.is_some_and(|l| l <= TARGET_S), "{latency:?}");
     assert!(flag_time(&acc, "brake_slip").is_some());
+}
+
+/// A current reading that loses most of its gain 5 ms before the drive is cut leaves the drive
+/// checks no time; with the drive's current command the reading is called within the drive
+/// (blocks of 1.6 ms). Tuning seed 2026's current_open runs 27 and 69 are this case.
+#[test]
+fn a_gain_lost_just_before_the_cut_is_called_within_the_drive_with_the_command() {
+    let mut scene = Scene::builtin(SceneKind::ReverseLoad, Reading::Physical);
+    let cut = scene.release_at_s.expect("reverse_load cuts its drive");
+    let fault = Fault {
+        kind: FaultKind::CurrentOpen,
+        at_s: cut - 0.005,
+        severity: 0.8,
+    };
+    scene.faults.push(fault);
+    let trace = scene_trace(&scene).expect("twin");
+    let estimates = run_monitor_with(&trace, Config::default(), true).expect("monitor");
+    let acc = compare(&trace, &estimates);
+    let latency = detection_latency_s(&fault, &trace, &acc);
+    println!(
+        "reverse_load, current_open 0.8 5 ms before the cut, with the command: latency \
+         {latency:?}, flags {:?}",
+        acc.flag_times()
+    );
+    assert!(latency.is_some_and(|l| l <= 0.005), "{latency:?}");
+    assert_eq!(
+        flag_time(&acc, "brake_drag"),
+        None,
+        "a sensor fault, not a drag"
+    );
 }

@@ -9,7 +9,7 @@
 //! | common slip | `brake_slip` | slow lane, `Checks`, drive off, held | `hold.rs`, `slip.rs` |
 //! | drag, steps of the drive's work | `brake_drag`, `sensor_fault` | slow lane, `Checks`, drive on | `drive.rs` |
 //! | dead current reading | `sensor_fault` | window lane, drive on | `dead_current.rs` |
-//! | reading against the drive's command | `sensor_fault` | window lane, drive on, command given | `current_command.rs` |
+//! | reading against the drive's command | `sensor_fault` | every tick, drive on, command given | `current_command.rs` |
 
 mod current_command;
 mod dead_current;
@@ -247,8 +247,8 @@ impl Checks {
             self.drive.suspect_current();
         }
         // The reading against the drive's own command, when the inputs carry it.
-        if let (true, Slot::DeadCurrent, Some(code)) = (drive, i.slot, x.command_code) {
-            if self.command.window(&k.command, x.current, code) {
+        if let (true, Some(code)) = (drive, x.command_code) {
+            if self.command.sample(&k.command, x.current, code) {
                 raised.sensor_fault = true;
                 self.drive.suspect_current();
             }

@@ -4,7 +4,8 @@
 //! and observes. The **background**, after every tick at a lower priority, runs that tick's
 //! events, per-tick checks (braking envelope, creep) and the pack torque the observer's model
 //! feeds forward, then the **slow lane** ([`SLOW`], 2.5 kHz), one part per slot, so that no
-//! background carries two of the costly parts:
+//! background carries two of the costly parts, and last, with the drive on and its command
+//! given, the command check's sample:
 //!
 //! | slot (tick mod 4) | work | module |
 //! |---|---|---|

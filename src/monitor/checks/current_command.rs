@@ -2,11 +2,11 @@
 //! loop closes on its own sensing, so the current it commands is the current that flows; a
 //! reading that has lost part of its gain reads less than the command whatever the load.
 //!
-//! Runs on the window lane's `DeadCurrent` slot (one tick in 16 with the drive on), only when
-//! the inputs carry the command (`Inputs::current_command_code`; without it, nothing changes).
-//! Over a block of [`BLOCK_WINDOWS`] samples, those whose command is at least the floor are
-//! summed: `S_c = Σ|c|` and `S_m = Σ m·sgn(c)` (`m` the reading about its commissioned zero).
-//! The block is bad when `|S_m − S_c| > tolerance·S_c` with at least half its samples used.
+//! Runs every tick with the drive on, only when the inputs carry the command
+//! (`Inputs::current_command_code`; without it, nothing changes). Over a block of
+//! [`BLOCK_TICKS`] samples, those whose command is at least the floor are summed: `S_c = Σ|c|`
+//! and `S_m = Σ m·sgn(c)` (`m` the reading about its commissioned zero). The block is bad when
+//! `|S_m − S_c| > tolerance·S_c` with at least half its samples used.
 //!
 //! Assumption: the command is the loop's reference and the loop follows it within a sample
 //! (a 1 kHz current loop lags 0.16 ms). A drive whose loop closes on the monitor's own sensor
@@ -15,12 +15,16 @@
 //! | quantity | format | range | resolution |
 //! |---|---|---|---|
 //! | command, reading | `i32` ADC counts about zero current | ±2^15 | 1 count |
-//! | sums over a block | `i32` counts | 8 × 2^15 | 1 count |
+//! | sums over a block | `i32` counts | 16 × 2^15 | 1 count |
 //! | tolerance | `i64` product with `S_c` in Q16 | exact | 1.5e-5 |
 
-use super::dead_current::BLOCK_WINDOWS;
 use crate::monitor::config::{Config, ConfigError};
 use crate::monitor::convert::{finite, require};
+
+/// Samples per block: 16 ticks, 1.6 ms at 10 kHz. Ten time constants of a 1 kHz current loop,
+/// so its lag after a step weighs ≤ 10 % of a block; a gain lost on a drive cut within
+/// milliseconds is still called.
+pub(crate) const BLOCK_TICKS: u8 = 16;
 
 /// The command check's constants.
 #[cfg_attr(
@@ -74,7 +78,7 @@ impl CommandSettings {
 pub(crate) struct CommandCheck {
     command_sum: i32,
     reading_sum: i32,
-    windows: u8,
+    samples: u8,
     used: u8,
 }
 
@@ -84,27 +88,27 @@ impl CommandCheck {
         *self = CommandCheck::default();
     }
 
-    /// One window's sample: the reading `current` (counts about its commissioned zero) and the
+    /// One tick's sample: the reading `current` (counts about its commissioned zero) and the
     /// command's code. Returns whether the block it ends reads off the command.
-    pub fn window(&mut self, k: &CommandSettings, current: i32, command_code: u16) -> bool {
+    pub fn sample(&mut self, k: &CommandSettings, current: i32, command_code: u16) -> bool {
         if k.tolerance_q16 == 0 {
             return false;
         }
         let c = i32::from(command_code) - k.zero_code;
         if c.saturating_abs() >= k.floor {
-            // |c|, |current| < 2^16 and 8 samples: the sums cannot overflow.
+            // |c|, |current| < 2^16 and 16 samples: the sums cannot overflow.
             self.command_sum = self.command_sum.saturating_add(c.saturating_abs());
             self.reading_sum =
                 self.reading_sum
                     .saturating_add(if c > 0 { current } else { -current });
             self.used = self.used.saturating_add(1);
         }
-        self.windows = self.windows.saturating_add(1);
-        if self.windows < BLOCK_WINDOWS {
+        self.samples = self.samples.saturating_add(1);
+        if self.samples < BLOCK_TICKS {
             return false;
         }
         let (s_c, s_m) = (i64::from(self.command_sum), i64::from(self.reading_sum));
-        let bad = self.used >= BLOCK_WINDOWS / 2 && (s_m - s_c).abs() << 16 > k.tolerance_q16 * s_c;
+        let bad = self.used >= BLOCK_TICKS / 2 && (s_m - s_c).abs() << 16 > k.tolerance_q16 * s_c;
         self.disarm();
         bad
     }
@@ -119,19 +123,19 @@ mod tests {
         CommandSettings::new(&Config::default()).unwrap()
     }
 
-    /// One block of `BLOCK_WINDOWS` samples, each commanding `c` counts about mid-scale and
+    /// One block of `BLOCK_TICKS` samples, each commanding `c` counts about mid-scale and
     /// reading `gain·c + offset`; whether the block is called off.
     fn block(k: &CommandSettings, c: i32, gain: f64, offset: i32) -> bool {
         let mut check = CommandCheck::default();
         let reading = (gain * f64::from(c)) as i32 + offset;
         let code = (2048 + c) as u16;
-        for _ in 1..BLOCK_WINDOWS {
+        for _ in 1..BLOCK_TICKS {
             assert!(
-                !check.window(k, reading, code),
+                !check.sample(k, reading, code),
                 "only the block's end decides"
             );
         }
-        check.window(k, reading, code)
+        check.sample(k, reading, code)
     }
 
     #[test]
