@@ -132,10 +132,10 @@ struct State {
     flags: Flags,
     /// A brake or sensor flag is latched (`Flags::fault`): no estimate is trusted.
     fault_latched: bool,
-    /// The last slow-lane run's slip checks saw the held brake give way (the next run's
+    /// The last background's slip checks saw the held brake give way (the next background's
     /// classification loses the hold).
     gave_way: bool,
-    /// The last slow-lane run changed the driving reading (bumpless for the observer).
+    /// The last background changed the driving reading (bumpless for the observer).
     reading_switch: bool,
     /// The commanded functional test, from the crew's request.
     test: Option<FunctionalTest>,
@@ -251,7 +251,7 @@ impl Monitor {
     }
 
     /// The 10 kHz interrupt's part: sense and observe, latch what they raised, report. The
-    /// estimate is the slow lane's last, with this tick's count, trust and flags. A slow lane
+    /// estimate is the slow lane's last, with this tick's count, trust and flags. A background
     /// that has not run since the last tick runs first: every tick's work runs once, in order.
     pub fn tick(&mut self, inputs: &Inputs) -> &Estimate {
         if self.job_due {
@@ -292,10 +292,11 @@ impl Monitor {
         st.report(o, k.commissioned)
     }
 
-    /// The slow lane's work for the last [`Monitor::tick`], at a lower priority before the
-    /// next tick: the tick's events, the per-tick checks (braking envelope, creep), the
-    /// observer's feed-forward, then one slot (classify, estimate, checks, window). Its flags
-    /// are latched here; the next tick reports them. Does nothing when called twice.
+    /// The rest of the last [`Monitor::tick`]'s work, at a lower priority before the next tick:
+    /// the tick's events, the per-tick checks (braking envelope, creep), the observer's
+    /// feed-forward, then one slow-lane slot (classify, estimate, checks, window) and the
+    /// command check. Its flags are latched here; the next tick reports them. Does nothing when
+    /// called twice.
     pub fn background(&mut self) {
         if !core::mem::take(&mut self.job_due) {
             return;

@@ -167,8 +167,9 @@ impl Checks {
         (raised, gave_way)
     }
 
-    /// The slow lane's checks on their slots (`c`: the last classification, `oc` the observer at
-    /// it; `o` this tick's); returns the flags raised and whether the held brake gave way.
+    /// The slow lane's checks on their slots, then the command check's sample (`c`: the last
+    /// classification, `oc` the observer at it; `o` this tick's); returns the flags raised and
+    /// whether the held brake gave way.
     #[allow(clippy::too_many_arguments)]
     pub fn slow(
         &mut self,

@@ -154,7 +154,7 @@ pub struct Thresholds {
     /// block (rad/s).
     pub dead_current_speed_rad_s: f64,
     /// How far the current reading may lie from the drive's own command, as a share of the
-    /// command, summed over a block of 12.8 ms (`sensor_fault`; `checks/current_command.rs`);
+    /// command, summed over a block of 1.6 ms (`sensor_fault`; `checks/current_command.rs`);
     /// runs only on inputs that carry the command; 0 turns it off.
     pub command_gain_tolerance: f64,
     /// Smallest commanded current (A, magnitude) the command check sums.
