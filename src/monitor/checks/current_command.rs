@@ -20,11 +20,13 @@
 
 use crate::monitor::config::{Config, ConfigError};
 use crate::monitor::convert::{finite, require};
+use crate::monitor::schedule::WINDOW;
 
-/// Samples per block: 16 ticks, 1.6 ms at 10 kHz. Ten time constants of a 1 kHz current loop,
-/// so its lag after a step weighs ≤ 10 % of a block; a gain lost on a drive cut within
-/// milliseconds is still called.
-pub(crate) const BLOCK_TICKS: u8 = 16;
+/// Samples per block: every tick of one [`WINDOW`], 1.6 ms at 10 kHz. Ten time constants of a
+/// 1 kHz current loop, so its lag after a step weighs ≤ 10 % of a block; a gain lost on a drive
+/// cut within milliseconds is still called.
+pub(crate) const BLOCK_TICKS: u8 = WINDOW.ticks as u8;
+const _: () = assert!(WINDOW.ticks <= u8::MAX as u32, "a block's count is a u8");
 
 /// The command check's constants.
 #[cfg_attr(
