@@ -130,7 +130,7 @@ struct State {
     energy: Energy,
     checks: Checks,
     flags: Flags,
-    /// A brake or sensor flag is latched (`Flags::fault`): no estimate is trusted.
+    /// A flag that distrusts the model is latched (`Flags::distrusts`): no estimate is trusted.
     fault_latched: bool,
     /// The last background's slip checks saw the held brake give way (the next background's
     /// classification loses the hold).
@@ -352,6 +352,8 @@ impl Monitor {
             drive_drag: k.pack.drive_drag,
             min_load: k.scene.min_load,
             settle_ticks: k.scene.engage_settle_ticks,
+            input_speed: st.sense.input_speed(),
+            stick_speed: k.scene.stick_speed,
         };
         let (raised, gave_way) =
             st.checks
@@ -484,7 +486,7 @@ impl State {
             return; // the common case, cheaply
         }
         self.flags = self.flags.union(raised);
-        self.fault_latched |= raised.fault();
+        self.fault_latched |= raised.distrusts();
     }
 
     /// The estimate of this tick: the last classification's, with this tick's count, trust

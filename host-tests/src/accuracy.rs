@@ -184,16 +184,6 @@ impl Accuracy {
     }
 }
 
-fn flag_list(f: Flags) -> [(bool, &'static str); 5] {
-    [
-        (f.brake_slip, "brake_slip"),
-        (f.brake_weak, "brake_weak"),
-        (f.brake_drag, "brake_drag"),
-        (f.sensor_fault, "sensor_fault"),
-        (f.overrun, "overrun"),
-    ]
-}
-
 /// First time after `from` at which `locked(i)` holds for [`LOCK_CONFIRM_S`].
 fn lock_time(t: &[f64], from: f64, locked: impl Fn(usize) -> bool) -> Option<f64> {
     let mut start: Option<usize> = None;
@@ -260,7 +250,7 @@ pub fn compare(trace: &Trace, estimates: &[Estimate]) -> Accuracy {
     let mut flags = Vec::new();
     let mut before = Flags::default();
     for (e, r) in estimates.iter().zip(rows) {
-        for ((now, name), (was, _)) in flag_list(e.flags).into_iter().zip(flag_list(before)) {
+        for ((now, name), (was, _)) in e.flags.named().into_iter().zip(before.named()) {
             if now && !was {
                 flags.push(FlagEvent {
                     flag: name,

@@ -80,6 +80,8 @@ pub struct Outcome {
     /// The functional test after the run ([`crate::dormant`]): every dormant fault run and a
     /// share of the nominal runs ([`Campaign::test_every`]), physical form only.
     pub test: Option<Verdict>,
+    /// `brake_degraded` rose after the fault's onset: the drive's own cycle found the fault.
+    pub warned: bool,
 }
 
 impl Outcome {
@@ -96,6 +98,7 @@ impl Outcome {
             error: None,
             not_driven: false,
             test: None,
+            warned: false,
         }
     }
 
@@ -465,6 +468,11 @@ pub fn evaluate(d: &Draw, campaign: &Campaign) -> Outcome {
         error: None,
         not_driven,
         test,
+        warned: fault.is_some()
+            && acc
+                .flags
+                .iter()
+                .any(|f| f.flag == "brake_degraded" && f.t_s >= onset),
     }
 }
 

@@ -102,11 +102,12 @@ fn check_pack_that_cannot_hold(kind: SceneKind, config: Config, within: f64) {
         "brake_weak {weak} vs cut {cut}"
     );
     assert!(latency.is_some_and(|l| l <= within), "{latency:?}");
-    // Nothing else before the output leaves the plausible speed range.
+    // Nothing else before the output leaves the plausible speed range but the warning of a
+    // closing with the drive on that already let the load through (`cycle_health.rs`).
     let runaway = runaway_time(&trace);
     for f in &acc.flags {
         assert!(
-            f.flag == "brake_weak" || f.flag == "brake_slip" || f.t_s >= runaway,
+            ["brake_weak", "brake_slip", "brake_degraded"].contains(&f.flag) || f.t_s >= runaway,
             "{} at {} (runaway at {runaway})",
             f.flag,
             f.t_s
@@ -279,8 +280,11 @@ fn a_pack_that_lets_the_output_speed_up_after_the_cut_is_flagged_within_30_ms() 
         "{weak} vs {}",
         cut.t_s
     );
+    // Before the cut only the warning that the drive held the door back (`cycle_health.rs`).
     assert!(
-        acc.flags.iter().all(|f| f.t_s >= cut.t_s),
+        acc.flags
+            .iter()
+            .all(|f| f.t_s >= cut.t_s || f.flag == "brake_degraded"),
         "{:?}",
         acc.flags
     );

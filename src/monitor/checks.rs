@@ -10,12 +10,14 @@
 //! | drag, steps of the drive's work | `brake_drag`, `sensor_fault` | slow lane, `Checks`, drive on | `drive.rs` |
 //! | dead current reading | `sensor_fault` | window lane, drive on | `dead_current.rs` |
 //! | reading against the drive's command | `sensor_fault` | every tick, drive on, command given | `current_command.rs` |
+//! | an overrunning load the pack let through | `brake_degraded` (warning) | slow lane, `Checks`, drive on, moving | `overrunning.rs` |
 
 mod current_command;
 mod dead_current;
 mod drive;
 mod envelope;
 mod hold;
+mod overrunning;
 mod slip;
 
 pub(crate) use current_command::CommandSettings;
@@ -23,12 +25,13 @@ pub(crate) use dead_current::DeadCurrentSettings;
 pub(crate) use drive::DriveSettings;
 pub(crate) use envelope::EnvelopeSettings;
 pub(crate) use hold::HoldSettings;
+pub(crate) use overrunning::OverrunningSettings;
 
 use super::config::{Config, ConfigError};
 use super::convert::ticks;
 use super::load::Load;
 use super::observe::Observed;
-use super::pack::{PackRatios, PackSettings};
+use super::pack::{Dir, PackRatios, PackSettings};
 use super::scene::Classified;
 use super::schedule::{Slot, SLOW};
 use super::sense::Sensed;
@@ -40,6 +43,7 @@ use drive::{DriveChecks, DriveTick};
 use envelope::Envelope;
 pub(crate) use envelope::{BrakingTick, Decel};
 use hold::HoldChecks;
+use overrunning::Overrunning;
 
 /// The checks' constants.
 #[cfg_attr(
@@ -54,6 +58,7 @@ pub(crate) struct CheckSettings {
     pub drive: DriveSettings,
     pub dead_current: DeadCurrentSettings,
     pub command: CommandSettings,
+    pub overrunning: OverrunningSettings,
 }
 
 impl CheckSettings {
@@ -73,6 +78,7 @@ impl CheckSettings {
             drive: DriveSettings::new(c, pack, r)?,
             dead_current: DeadCurrentSettings::new(c, r)?,
             command: CommandSettings::new(c)?,
+            overrunning: OverrunningSettings::new(c)?,
         })
     }
 }
@@ -84,6 +90,9 @@ pub(crate) struct CheckInputs {
     pub min_load: Q16,
     /// The observer's settling after a change of the pack's reading (ticks).
     pub settle_ticks: u32,
+    /// The input shaft's filtered speed and the band within which a shaft stands.
+    pub input_speed: Q16,
+    pub stick_speed: Q16,
 }
 
 /// The checks' state.
@@ -99,6 +108,7 @@ pub(crate) struct Checks {
     drive: DriveChecks,
     dead_current: DeadCurrent,
     command: CommandCheck,
+    overrunning: Overrunning,
 }
 
 impl Checks {
@@ -110,6 +120,7 @@ impl Checks {
             drive: DriveChecks::default(),
             dead_current: DeadCurrent::default(),
             command: CommandCheck::default(),
+            overrunning: Overrunning::default(),
         }
     }
 
@@ -122,6 +133,7 @@ impl Checks {
     pub fn reset(&mut self, counters: (u32, u32)) {
         self.weak_ticks = 0;
         self.drive.reset();
+        self.overrunning.disarm();
         self.envelope = Envelope::default();
         self.hold.restart(counters.0, counters.1);
     }
@@ -139,6 +151,7 @@ impl Checks {
             self.hold.disarm_slip();
             self.dead_current.disarm(x.out);
             self.command.disarm();
+            self.overrunning.disarm();
         }
     }
 
@@ -207,6 +220,15 @@ impl Checks {
                 && !c.dir.is_none()
                 && c.scene != Scene::Holding
                 && c.phase_settled;
+            // The pack carries an overrunning load: the drive must not hold the motion back.
+            if drive && checks_ok {
+                let input = Dir::of(i.input_speed, i.stick_speed);
+                raised.brake_degraded =
+                    self.overrunning
+                        .sample(&k.overrunning, c.dir, input, c.along);
+            } else {
+                self.overrunning.disarm();
+            }
             if drive && checks_ok && c.steady_for_checks {
                 let t = DriveTick {
                     dir: c.dir,

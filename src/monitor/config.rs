@@ -159,6 +159,11 @@ pub struct Thresholds {
     pub command_gain_tolerance: f64,
     /// Smallest commanded current (A, magnitude) the command check sums.
     pub command_floor_a: f64,
+    /// Mean drive torque against the output's motion (N·m) over `held_back_time_s` with the
+    /// drive on that says the pack let an overrunning load through (`brake_degraded`).
+    pub held_back_torque_nm: f64,
+    /// The block over which that mean is taken (s).
+    pub held_back_time_s: f64,
     /// Rate at which the pack-health estimate may move (1/s, sign-LMS step).
     pub health_rate_per_s: f64,
     /// Time over which an impact in the lost motion may reverse the output speed before the
@@ -207,6 +212,8 @@ impl Thresholds {
         dead_current_speed_rad_s: 2.0,
         command_gain_tolerance: 0.3,
         command_floor_a: 2.5,
+        held_back_torque_nm: 3.0, // healthy ≥ −0.6 N·m; a pack that lets the load through: ≈ −M
+        held_back_time_s: 0.02,
         health_rate_per_s: 25.0,
         impact_time_s: 0.01,
         impact_window_s: 0.0016,

@@ -160,10 +160,14 @@ pub struct Flags {
     pub sensor_fault: bool,
     /// A tick was missed.
     pub overrun: bool,
+    /// Warning, not an alarm: the pack did not carry an overrunning load (the drive held the
+    /// motion back); it may not hold once the drive lets go (`checks/overrunning.rs`).
+    pub brake_degraded: bool,
 }
 
 impl Flags {
-    /// Packs the flags: bit 0 brake_slip, 1 brake_weak, 2 brake_drag, 3 sensor_fault, 4 overrun.
+    /// Packs the flags: bit 0 brake_slip, 1 brake_weak, 2 brake_drag, 3 sensor_fault, 4 overrun,
+    /// 5 brake_degraded.
     ///
     /// ```
     /// use noback::monitor::Flags;
@@ -177,9 +181,10 @@ impl Flags {
             | (self.brake_drag as u8) << 2
             | (self.sensor_fault as u8) << 3
             | (self.overrun as u8) << 4
+            | (self.brake_degraded as u8) << 5
     }
 
-    /// Inverse of [`Flags::bits`]; bits 5–7 are ignored.
+    /// Inverse of [`Flags::bits`]; bits 6 and 7 are ignored.
     pub const fn from_bits(bits: u8) -> Flags {
         Flags {
             brake_slip: bits & 1 != 0,
@@ -187,7 +192,20 @@ impl Flags {
             brake_drag: bits & 4 != 0,
             sensor_fault: bits & 8 != 0,
             overrun: bits & 16 != 0,
+            brake_degraded: bits & 32 != 0,
         }
+    }
+
+    /// Each flag with its name, in bit order.
+    pub const fn named(self) -> [(bool, &'static str); 6] {
+        [
+            (self.brake_slip, "brake_slip"),
+            (self.brake_weak, "brake_weak"),
+            (self.brake_drag, "brake_drag"),
+            (self.sensor_fault, "sensor_fault"),
+            (self.overrun, "overrun"),
+            (self.brake_degraded, "brake_degraded"),
+        ]
     }
 
     /// Whether any flag is raised.
@@ -195,11 +213,18 @@ impl Flags {
         self.bits() != 0
     }
 
-    /// Whether a brake or sensor fault is raised (every flag but `overrun`, which says a tick
-    /// was missed, not that the plant or a sensor is other than the model).
+    /// Whether an alarm is raised: a brake or sensor fault (every flag but `overrun`, a missed
+    /// tick, and the `brake_degraded` warning).
     #[inline]
     pub const fn fault(&self) -> bool {
         self.brake_slip | self.brake_weak | self.brake_drag | self.sensor_fault
+    }
+
+    /// Whether the plant or a sensor is not the model's: an alarm ([`Flags::fault`]) or the
+    /// `brake_degraded` warning. The estimate is untrusted from then on.
+    #[inline]
+    pub const fn distrusts(&self) -> bool {
+        self.fault() | self.brake_degraded
     }
 
     /// Flags raised in `self` or `other`.
@@ -211,6 +236,7 @@ impl Flags {
             brake_drag: self.brake_drag | other.brake_drag,
             sensor_fault: self.sensor_fault | other.sensor_fault,
             overrun: self.overrun | other.overrun,
+            brake_degraded: self.brake_degraded | other.brake_degraded,
         }
     }
 }

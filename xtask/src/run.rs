@@ -117,17 +117,11 @@ pub fn line_with<'a>(
 }
 
 pub fn flag_names(bits: u8) -> Vec<&'static str> {
-    let f = Flags::from_bits(bits);
-    [
-        (f.brake_slip, "brake_slip"),
-        (f.brake_weak, "brake_weak"),
-        (f.brake_drag, "brake_drag"),
-        (f.sensor_fault, "sensor_fault"),
-        (f.overrun, "overrun"),
-    ]
-    .into_iter()
-    .filter_map(|(on, name)| on.then_some(name))
-    .collect()
+    Flags::from_bits(bits)
+        .named()
+        .into_iter()
+        .filter_map(|(on, name)| on.then_some(name))
+        .collect()
 }
 
 /// Entry.

@@ -48,6 +48,9 @@ pub struct FaultRun {
     /// The functional test after the run: `rejected`, `pass` or `fail`; absent if not run.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub test: Option<String>,
+    /// `brake_degraded` rose after the onset.
+    #[serde(default)]
+    pub warned: bool,
 }
 
 /// A nominal run the twin could not run.
@@ -180,6 +183,7 @@ impl Part {
                     false_flags_with_command: o.false_flags_with_command,
                     error: o.error.clone(),
                     test: o.test.map(|v| verdict_tag(v).into()),
+                    warned: o.warned,
                 })
                 .collect(),
         }
@@ -212,6 +216,7 @@ fn outcome_of(r: &FaultRun) -> Result<Outcome, String> {
         error: r.error.clone(),
         not_driven: false,
         test: r.test.as_deref().map(verdict_of).transpose()?,
+        warned: r.warned,
     })
 }
 

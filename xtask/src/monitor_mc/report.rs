@@ -110,23 +110,26 @@ pub fn build(meta: &Meta, outcomes: &[Outcome]) -> Result<Value, String> {
                 })
             })
             .collect();
-        // Dormant: the fault never showed to the sensors in its scene; found by the
-        // functional test after the run (the physical form only can run it).
+        // Dormant: the fault never showed as a failure to hold in its scene; found by the
+        // drive's own cycle (`brake_degraded` in the run) or by the functional test after it
+        // (the physical form only can run it).
         let dormant: Vec<&Outcome> = runs.iter().copied().filter(|o| !o.manifested).collect();
         let tested: Vec<&Outcome> = dormant
             .iter()
             .copied()
-            .filter(|o| matches!(o.test, Some(Verdict::Pass | Verdict::Fail)))
+            .filter(|o| o.warned || matches!(o.test, Some(Verdict::Pass | Verdict::Fail)))
             .collect();
+        let warned = dormant.iter().filter(|o| o.warned).count();
         let found = tested
             .iter()
-            .filter(|o| o.test == Some(Verdict::Fail))
+            .filter(|o| o.warned || o.test == Some(Verdict::Fail))
             .count();
         rows.push(json!({
             "kind": format!("{kind:?}"),
             "runs": runs.len(),
             "dormant": dormant.len(),
             "dormant_tested": tested.len(),
+            "dormant_warned": warned,
             "dormant_found": found,
             "dormant_found_rate": rate(found, tested.len()),
             "dormant_rejected_at_acceptance": dormant.iter().filter(|o| o.test == Some(Verdict::Rejected)).count(),
