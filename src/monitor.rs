@@ -469,7 +469,10 @@ impl State {
             drive_torque_nm: o.drive_torque,
             output_speed_rad_s: o.w,
             input_speed_rad_s: self.sense.input_speed(),
-            capacity_margin: if load.saturating_abs() < k.scene.min_load {
+            // A pack seen letting an overrunning load through holds less than that load.
+            capacity_margin: if self.flags.brake_degraded {
+                Q16::ZERO
+            } else if load.saturating_abs() < k.scene.min_load {
                 MARGIN_MAX
             } else {
                 self.load.cache.margin

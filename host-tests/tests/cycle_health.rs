@@ -16,8 +16,8 @@ use noback_twin::scene::{Scene, SceneKind};
 const ONSET_S: f64 = 0.6;
 
 /// A closing at 20 N·m with `fault` from [`ONSET_S`]: the warning's time and whether the
-/// estimate is trusted at the end.
-fn closing_with(kind: FaultKind, severity: f64) -> (Option<f64>, bool) {
+/// estimate at the end is trusted and reports a capacity margin.
+fn closing_with(kind: FaultKind, severity: f64) -> (Option<f64>, bool, bool) {
     let mut scene = Scene::builtin(SceneKind::ContinuousClosing, Reading::Physical);
     scene.load_torque_nm = 20.0;
     scene.duration_s = 1.0;
@@ -34,7 +34,12 @@ fn closing_with(kind: FaultKind, severity: f64) -> (Option<f64>, bool) {
         .iter()
         .find(|f| f.flag == "brake_degraded")
         .map(|f| f.t_s);
-    (warned, estimates.last().is_some_and(|e| e.trusted))
+    let last = estimates.last();
+    (
+        warned,
+        last.is_some_and(|e| e.trusted),
+        last.is_some_and(|e| e.capacity_margin > 0),
+    )
 }
 
 #[test]
@@ -44,7 +49,7 @@ fn a_pack_that_lets_the_closing_load_through_is_warned_within_the_closing() {
         FaultKind::RampJam,
         FaultKind::FrictionLoss,
     ] {
-        let (warned, trusted) = closing_with(kind, 0.6);
+        let (warned, trusted, margin) = closing_with(kind, 0.6);
         println!("{kind:?}: brake_degraded at {warned:?}");
         // The pack lets go within ~10 ms of the onset; a 20 ms block, once the shafts turn
         // together again, then at most one more.
@@ -53,6 +58,10 @@ fn a_pack_that_lets_the_closing_load_through_is_warned_within_the_closing() {
         assert!(
             !trusted,
             "{kind:?}: the estimate after the warning must be untrusted"
+        );
+        assert!(
+            !margin,
+            "{kind:?}: a pack that let the load through has no margin"
         );
     }
 }

@@ -274,7 +274,8 @@ pub struct Estimate {
     /// Input-shaft speed (rad/s), motor encoder ÷ reducer ratio.
     pub input_speed_rad_s: Q16,
     /// Braking capacity (ramps engaged, scaled by the pack health) over |load|; saturates at
-    /// [`crate::monitor::MARGIN_MAX`] for loads below the minimum.
+    /// [`crate::monitor::MARGIN_MAX`] for loads below the minimum; 0 once `brake_degraded` rose
+    /// (the pack let a load through: it holds less than the load).
     pub capacity_margin: Q16,
     /// Pack health: measured over model braking torque while slipping (1.0 nominal).
     pub pack_health: Q16,
