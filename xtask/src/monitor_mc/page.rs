@@ -161,10 +161,11 @@ pub fn table(r: &Value) -> String {
     let ft = &r["functional_tests_nominal"];
     let _ = writeln!(
         s,
-        "\nDormant faults (never shown as a failure to hold in their scene), found by the drive's \
-         own cycle (`brake_degraded` in the run: the pack let an overrunning load through) or \
-         by the functional test after the run (physical form; docs/functional-test.md). \
-         Nominal runs tested: {}, failed {} {}, healthy units rejected at acceptance {}.\n",
+        "\nDormant faults (runs whose fault never manifested, as defined above), found by the \
+         drive's own cycle (`brake_degraded` in the run: the pack let an overrunning load \
+         through) or by the functional test after the run (physical form; \
+         docs/functional-test.md). Nominal runs tested: {}, failed {} {}, healthy units \
+         rejected at acceptance {}.\n",
         ft["tested"],
         ft["failed"],
         fmt_rate(&ft["failed_rate"]),
