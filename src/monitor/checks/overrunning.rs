@@ -8,6 +8,7 @@
 //! | quantity | format | range | resolution |
 //! |---|---|---|---|
 //! | drive torque along the motion | [`Q16`] N·m bits summed, saturating | ±2^31 bits | 1.5e-5 N·m |
+//! | the block's held-back sum | `i32` Q16 N·m bits (`new` rejects beyond) | −2^31 … 0 | 1.5e-5 N·m |
 //! | block | `u16` slow-lane calls | 1 … 2^16 − 1 | 0.4 ms |
 
 use crate::fx::Q16;
@@ -23,8 +24,8 @@ use crate::monitor::schedule::SLOW;
 )]
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub(crate) struct OverrunningSettings {
-    /// Mean drive torque against the motion (N·m, positive) above which the drive holds it back.
-    limit: Q16,
+    /// `−held_back_torque_nm · block` (Q16 bits): a block summing below it held the motion back.
+    held_back_sum: i32,
     /// Slow-lane calls per block.
     block: u16,
 }
@@ -42,10 +43,17 @@ impl OverrunningSettings {
             (1.0..f64::from(u16::MAX)).contains(&calls),
             "thresholds.held_back_time_s",
         )?;
+        // 1 ≤ calls < 2^16 (checked above).
+        let block = (calls + 0.5) as u16;
+        let held_back_sum =
+            i32::try_from(-i64::from(limit.to_bits()) * i64::from(block)).map_err(|_| {
+                ConfigError::Overflow {
+                    parameter: "thresholds.held_back_torque_nm",
+                }
+            })?;
         Ok(OverrunningSettings {
-            limit,
-            // 1 ≤ calls < 2^16 (checked above).
-            block: (calls + 0.5) as u16,
+            held_back_sum,
+            block,
         })
     }
 }
@@ -86,8 +94,8 @@ impl Overrunning {
         if self.calls < k.block {
             return false;
         }
-        // Mean below −limit, without a division: Σ < −limit·n (i64: no overflow).
-        let held_back = i64::from(self.sum) < -i64::from(k.limit.to_bits()) * i64::from(k.block);
+        // Mean below −limit, without a division: Σ < −limit·n.
+        let held_back = self.sum < k.held_back_sum;
         self.disarm();
         held_back
     }
@@ -110,12 +118,17 @@ mod tests {
 
     #[test]
     fn a_drive_that_holds_the_motion_back_beyond_the_limit_is_called_at_the_block_end() {
-        let k = OverrunningSettings::new(&Config::default()).expect("default configuration");
-        let (limit, with) = (k.limit.to_num::<f64>(), Dir::of(Q16::ONE, Q16::ZERO));
+        let c = Config::default();
+        let k = OverrunningSettings::new(&c).expect("default configuration");
+        let (limit, with) = (
+            c.thresholds.held_back_torque_nm,
+            Dir::of(Q16::ONE, Q16::ZERO),
+        );
         assert!(block_of(&k, with, -limit - 0.1));
         assert!(!block_of(&k, with, -limit + 0.1));
-        assert!(!block_of(&k, with, 2.0)); // a healthy overrunning drive pushes along the motion
-                                           // The output thrown back while the input stands: no block.
+        // A healthy overrunning drive pushes along the motion.
+        assert!(!block_of(&k, with, 2.0));
+        // The output thrown back while the input stands: no block.
         assert!(!block_of(&k, Dir::NONE, -limit - 10.0));
     }
 }
