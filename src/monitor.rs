@@ -80,7 +80,7 @@ pub use config::{
     DEFAULT_OBSERVER_BANDWIDTH_HZ, DEFAULT_TICK_HZ, POWER_ON_SEED_TICKS,
 };
 pub use io::{BrakeState, Estimate, Flags, Inputs, Scene, SceneModel, ESTIMATE_WORDS};
-pub use scale::{recip_q16, sat_i32, Scale, ScaleError};
+pub use scale::{sat_i32, Scale, ScaleError};
 #[cfg(feature = "snapshot")]
 pub use snapshot::SnapshotError;
 
@@ -96,7 +96,7 @@ use schedule::{Slot, WINDOW};
 use sense::{Sense, Sensed};
 pub use settings::Settings;
 
-/// Largest capacity margin reported (loads below `min_load_nm` report this).
+/// Largest capacity margin reported (the load stage's builder keeps margins below it).
 pub const MARGIN_MAX: Q16 = Q16::from_bits(1000 << 16);
 
 /// `a·b` for two Q16 values, rounded toward −∞ and saturated: the bits of `fixed`'s
@@ -169,17 +169,18 @@ impl Monitor {
     /// );
     /// ```
     pub fn new(config: Config) -> Result<Monitor, ConfigError> {
-        Ok(Monitor::with_settings(Settings::new(&config)?))
+        Ok(Monitor::with_settings(&Settings::new(&config)?))
     }
 
     /// A monitor at power-on on settings already converted (a configuration block's). Inlined,
-    /// so a caller writing it into a static builds it there (the part's init stack).
+    /// and reading them where they are, so a caller writing it into a static copies them once,
+    /// there (the part's init stack).
     #[inline(always)]
-    pub fn with_settings(settings: Settings) -> Monitor {
+    pub fn with_settings(settings: &Settings) -> Monitor {
         let mut load = Load::new();
-        refresh_load(&mut load, &settings);
+        refresh_load(&mut load, settings);
         Monitor {
-            settings,
+            settings: *settings,
             state: State {
                 tick: 0,
                 sense: Sense::new(),
@@ -188,7 +189,8 @@ impl Monitor {
                 classified: Classified::NONE,
                 observed: Observed::NONE,
                 load,
-                estimate: Estimate::NONE,
+                // A healthy pack's margins until the first classification.
+                estimate: Estimate::with_margins(settings.load.healthy_margins()),
                 energy: Energy::new(),
                 checks: Checks::new(),
                 flags: Flags::default(),
@@ -453,6 +455,12 @@ impl State {
         );
         self.energy
             .update(&k.estimate, self.tick, pe.braking_torque, o.w, !locked);
+        // A pack seen holding less than a load it met: no margin is claimed.
+        let (margin, margin_low) = if self.flags.pack_weak() {
+            (Q16::ZERO, Q16::ZERO)
+        } else {
+            k.load.margins(self.load.health)
+        };
         self.estimate = Estimate {
             scene: c.scene,
             brake: if locked {
@@ -469,14 +477,8 @@ impl State {
             drive_torque_nm: o.drive_torque,
             output_speed_rad_s: o.w,
             input_speed_rad_s: self.sense.input_speed(),
-            // A pack seen letting an overrunning load through holds less than that load.
-            capacity_margin: if self.flags.brake_degraded {
-                Q16::ZERO
-            } else if load.saturating_abs() < k.scene.min_load {
-                MARGIN_MAX
-            } else {
-                self.load.cache.margin
-            },
+            capacity_margin: margin,
+            capacity_margin_low: margin_low,
             pack_health: self.load.health,
             friction_energy_j: self.energy.joules,
             ..self.estimate
@@ -490,6 +492,13 @@ impl State {
         }
         self.flags = self.flags.union(raised);
         self.fault_latched |= raised.distrusts();
+        if raised.pack_weak() {
+            // From this tick on (the Estimate slot keeps them 0).
+            (
+                self.estimate.capacity_margin,
+                self.estimate.capacity_margin_low,
+            ) = (Q16::ZERO, Q16::ZERO);
+        }
     }
 
     /// The estimate of this tick: the last classification's, with this tick's count, trust
@@ -508,7 +517,7 @@ impl State {
     }
 }
 
-/// `load`'s cache for its present load (its reciprocal and products).
+/// `load`'s cache for its present load (capacity, margin floor, decelerations).
 fn refresh_load(load: &mut Load, k: &Settings) {
     let value = load.estimate.value();
     let capacity = k.pack.capacity(k.pack.clamped_force(value));

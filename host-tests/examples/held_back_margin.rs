@@ -62,11 +62,7 @@ fn main() -> Result<(), String> {
     let mut args = std::env::args().skip(1);
     let (runs, seed) = runs_and_seed(&mut args, 300, 2026);
     let rest: Vec<String> = args.collect();
-    let family = if rest.iter().any(|a| a == "plant") {
-        Family::Plant
-    } else {
-        Family::PhysicalDefault
-    };
+    let family = Family::from_args(&rest);
     let healthy_only = rest.iter().any(|a| a == "healthy");
     println!(
         "family {}, seed {seed}, {runs} draws per row; N·m along the motion",

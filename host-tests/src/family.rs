@@ -39,6 +39,15 @@ impl Family {
         }
     }
 
+    /// The family an example's arguments name: `plant`, else the physical default.
+    pub fn from_args(args: &[String]) -> Family {
+        if args.iter().any(|a| a == "plant") {
+            Family::Plant
+        } else {
+            Family::PhysicalDefault
+        }
+    }
+
     /// Parses a name.
     pub fn parse(name: &str) -> Option<Family> {
         Family::ALL.into_iter().find(|f| f.name() == name)

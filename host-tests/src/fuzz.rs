@@ -46,10 +46,14 @@ pub fn check_estimate(
             "pressing force {force} N out of its format's positive range"
         ));
     }
-    if e.capacity_margin < 0 || e.capacity_margin > MARGIN_MAX {
+    if e.capacity_margin < 0
+        || e.capacity_margin > MARGIN_MAX
+        || e.capacity_margin_low < 0
+        || e.capacity_margin_low > e.capacity_margin
+    {
         return Err(format!(
-            "capacity margin {} out of [0, MARGIN_MAX]",
-            e.capacity_margin
+            "capacity margin {} (low {}) out of 0 ≤ low ≤ margin ≤ MARGIN_MAX",
+            e.capacity_margin, e.capacity_margin_low
         ));
     }
     if let Some(p) = prev {

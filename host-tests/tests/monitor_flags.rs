@@ -230,13 +230,15 @@ fn estimate_words_round_trip_the_fields() {
     assert_eq!(w.len(), ESTIMATE_WORDS);
     assert_eq!(w[0], 300);
     assert_eq!(w[1] as i32, e.pressing_force_n.to_bits());
-    assert_eq!(w[12] & 0xFF, BrakeState::Locked as u32);
-    assert_eq!((w[12] >> 8) & 0xFF, Scene::Holding as u32);
-    assert_eq!(w[12] >> 24, u32::from(e.flags.bits()));
+    assert_eq!(w[8] as i32, e.capacity_margin.to_bits());
+    assert_eq!(w[9] as i32, e.capacity_margin_low.to_bits());
+    assert_eq!(w[13] & 0xFF, BrakeState::Locked as u32);
+    assert_eq!((w[13] >> 8) & 0xFF, Scene::Holding as u32);
+    assert_eq!(w[13] >> 24, u32::from(e.flags.bits()));
     // The checksum covers the body: a changed field changes it.
     let mut other = e;
     other.tick += 1;
-    assert_ne!(other.to_words()[13], w[13]);
+    assert_ne!(other.to_words()[14], w[14]);
 }
 
 fn err(config: Config) -> ConfigError {

@@ -590,24 +590,6 @@ mod envelope {
     /// classification, which reaches the report up to `SLOW.ticks` ticks later.
     const QUIET_TICKS: u32 = 33 + noback::monitor::schedule::SLOW.ticks;
 
-    /// For each estimate of a trace, the loads of the last 16 estimates with the drive on (the
-    /// ones the monitor's load cache may hold).
-    fn cache_loads(trace: &[(f64, f64, Estimate)]) -> Vec<Vec<f64>> {
-        let mut window: Vec<f64> = Vec::new();
-        trace
-            .iter()
-            .map(|(_, _, e)| {
-                if matches!(e.scene, Scene::Driving | Scene::Overrunning) {
-                    window.push(e.load_torque_nm.to_num::<f64>());
-                    if window.len() > 16 {
-                        window.remove(0);
-                    }
-                }
-                window.clone()
-            })
-            .collect()
-    }
-
     /// For each estimate of a trace, whether the plant's output has been at rest for
     /// [`QUIET_TICKS`] ticks.
     fn quiet(trace: &[(f64, f64, Estimate)]) -> Vec<bool> {
@@ -625,7 +607,7 @@ mod envelope {
     /// drive torque, braking torque) with the physical reading's laws. `quiet`: the output has
     /// been at rest long enough for the holding torque to be the load alone (otherwise it also
     /// carries the output's inertia torque, checked in the library's unit test).
-    fn check_shadow(e: &Estimate, quiet: bool, cache_loads: &[f64]) -> Result<(), TestCaseError> {
+    fn check_shadow(e: &Estimate, quiet: bool) -> Result<(), TestCaseError> {
         let m = TABLE2;
         let load = e.load_torque_nm.to_num::<f64>();
         let spring = m.spring_preload_n();
@@ -662,26 +644,25 @@ mod envelope {
                 want
             );
         }
-        if load.abs() >= 1.0 {
-            // The margin is formed from the load cache, which follows the load once in 16
-            // ticks while driving and holds with the drive off: it matches one of the loads
-            // of the last 16 driving ticks.
-            let got = e.capacity_margin.to_num::<f64>();
-            let margin = |l: f64| {
-                let cap = m.pack_capacity_nm(m.quasi_static_pressing_force_n(l), m.mu_static);
-                // A zero load: the reciprocal saturates, and so does the margin.
-                (e.pack_health.to_num::<f64>() * cap / l.abs().max(1e-12)).min(1000.0)
-            };
-            let matched = cache_loads
-                .iter()
-                .chain(std::iter::once(&load))
-                .any(|&l| (got - margin(l)).abs() <= 1e-3 * margin(l) + 1e-4);
+        // The margin: capacity at the largest expected load over that load, times the health;
+        // its lower bound takes the model's spread off and credits no health above 1.
+        let c = Config::physical_reading();
+        let max = c.thresholds.max_load_nm;
+        let service = m.pack_capacity_nm(m.quasi_static_pressing_force_n(max), c.capacity_mu) / max;
+        let h = e.pack_health.to_num::<f64>();
+        let low = h.min(1.0) * service * (1.0 - c.thresholds.capacity_uncertainty);
+        // None once the pack was seen holding less than a load it met.
+        let weak = if e.flags.pack_weak() { 0.0 } else { 1.0 };
+        for (got, want) in [
+            (e.capacity_margin, weak * h * service),
+            (e.capacity_margin_low, weak * low),
+        ] {
+            let got = got.to_num::<f64>();
             prop_assert!(
-                matched,
-                "margin {} vs {} (loads {:?})",
+                (got - want).abs() <= 1e-4 * want + 1e-4,
+                "margin {} vs {}",
                 got,
-                margin(load),
-                cache_loads
+                want
             );
         }
         if e.brake == BrakeState::Locked && quiet {
@@ -741,8 +722,8 @@ mod envelope {
             plant.out_offset = offset;
             let mut monitor = Monitor::new(Config::physical_reading()).unwrap();
             let trace = run(&mut plant, &mut monitor, speed, 0.3, 1.0);
-            for (((t, w, e), q), c) in trace.iter().zip(quiet(&trace)).zip(cache_loads(&trace)) {
-                check_shadow(e, q, &c)?;
+            for ((t, w, e), q) in trace.iter().zip(quiet(&trace)) {
+                check_shadow(e, q)?;
                 if *t > 0.15 {
                     let got = e.output_speed_rad_s.to_num::<f64>();
                     prop_assert!((got - w).abs() <= 0.5 + 0.05 * w.abs(), "t {} speed {} vs {}", t, got, w);
@@ -781,8 +762,8 @@ mod envelope {
             plant.out_offset = offset;
             let mut monitor = Monitor::new(Config::physical_reading()).unwrap();
             let trace = run(&mut plant, &mut monitor, speed, 0.3, 1.0);
-            for (((_, _, e), q), c) in trace.iter().zip(quiet(&trace)).zip(cache_loads(&trace)) {
-                check_shadow(e, q, &c)?;
+            for ((_, _, e), q) in trace.iter().zip(quiet(&trace)) {
+                check_shadow(e, q)?;
             }
             let last = trace.last().unwrap().2;
             prop_assert_eq!(last.brake, BrakeState::Locked);
@@ -814,8 +795,8 @@ mod envelope {
             // left out of the speed comparison.
             let mut stopped_at = f64::NEG_INFINITY;
             let mut prev_w = speed;
-            for (((t, w, e), q), c) in trace.iter().zip(quiet(&trace)).zip(cache_loads(&trace)) {
-                check_shadow(e, q, &c)?;
+            for ((t, w, e), q) in trace.iter().zip(quiet(&trace)) {
+                check_shadow(e, q)?;
                 if *w == 0.0 && prev_w != 0.0 {
                     stopped_at = *t;
                 }

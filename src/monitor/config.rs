@@ -99,6 +99,9 @@ pub struct Thresholds {
     pub opposed_braking_share: f64,
     /// Lowest capacity margin (capacity over |load|) before `brake_weak`.
     pub min_capacity_margin: f64,
+    /// Relative uncertainty of the pack's modelled capacity (0 … 1): the reported margin's
+    /// lower bound is `1 − capacity_uncertainty` of the model's (Table 2 ± 10 %).
+    pub capacity_uncertainty: f64,
     /// Loads below this (N·m) are too small for a margin or a load direction.
     pub min_load_nm: f64,
     /// Pack torque above the nominal spring drag allowed while driving (N·m): `brake_drag`.
@@ -192,6 +195,7 @@ impl Thresholds {
         undecelerated_allowance_rad: 0.01,
         opposed_braking_share: 0.0, // the paper reading: only the load slows the output
         min_capacity_margin: 1.5,
+        capacity_uncertainty: 0.22, // Table 2 ± 10 %: 2.5 % of plants hold less than 0.79×
         min_load_nm: 1.0,
         drag_allowance_nm: 8.0,
         step_allowance_nm: 1.25,

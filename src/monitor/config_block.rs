@@ -4,7 +4,7 @@
 //!
 //! | bytes | what |
 //! |---|---|
-//! | 4 | magic `NBC6` (a later layout of the settings changes it) |
+//! | 4 | magic `NBC7` (a later layout of the settings changes it) |
 //! | n | the monitor's settings (`Settings::new` of the `Config`), postcard |
 //! | 4 | CRC-32/ISCSI of the settings' bytes, little-endian (postcard's `use-crc` flavour) |
 //!
@@ -16,8 +16,8 @@ use super::{Config, ConfigError, Monitor};
 use crc::{Crc, CRC_32_ISCSI};
 
 /// The block's first bytes.
-pub const CONFIG_BLOCK_MAGIC: [u8; 4] = *b"NBC6";
-/// Room the firmware keeps for a block (the default settings' block takes 293 bytes).
+pub const CONFIG_BLOCK_MAGIC: [u8; 4] = *b"NBC7";
+/// Room the firmware keeps for a block (the default settings' block takes 299 bytes).
 pub const CONFIG_BLOCK_BYTES: usize = 1024;
 
 const CRC: Crc<u32> = Crc::<u32>::new(&CRC_32_ISCSI);
@@ -48,7 +48,7 @@ pub fn encode(c: &Config, buf: &mut [u8]) -> Result<usize, ConfigBlockError> {
 
 /// The monitor at power-on on a block's settings (trailing bytes after it are ignored).
 pub fn decode(bytes: &[u8]) -> Result<Monitor, ConfigBlockError> {
-    read(bytes, |s| Monitor::with_settings(*s))
+    read(bytes, Monitor::with_settings)
 }
 
 /// `f` of a block's settings (trailing bytes after it are ignored). `f` runs where they were
@@ -116,7 +116,7 @@ mod tests {
         let crc = u32::from_le_bytes(buf[n - 4..n].try_into().unwrap());
         assert_eq!(
             (n, crc),
-            (293, 0x9756_4C25),
+            (299, 0xA7A7_20CF),
             "length and CRC of the default block"
         );
     }

@@ -227,6 +227,13 @@ impl Flags {
         self.fault() | self.brake_degraded
     }
 
+    /// Whether the pack was seen holding less than its model: it gave way, braked weakly or let
+    /// an overrunning load through. The reported capacity margin is 0 from then on.
+    #[inline]
+    pub const fn pack_weak(&self) -> bool {
+        self.brake_slip | self.brake_weak | self.brake_degraded
+    }
+
     /// Flags raised in `self` or `other`.
     #[inline]
     pub const fn union(self, other: Flags) -> Flags {
@@ -242,7 +249,7 @@ impl Flags {
 }
 
 /// Number of words in [`Estimate::to_words`].
-pub const ESTIMATE_WORDS: usize = 14;
+pub const ESTIMATE_WORDS: usize = 15;
 
 /// The monitor's output for one tick. Signs follow the output shaft: positive = the direction
 /// in which a positive load torque turns it.
@@ -273,10 +280,12 @@ pub struct Estimate {
     pub output_speed_rad_s: Q16,
     /// Input-shaft speed (rad/s), motor encoder ÷ reducer ratio.
     pub input_speed_rad_s: Q16,
-    /// Braking capacity (ramps engaged, scaled by the pack health) over |load|; saturates at
-    /// [`crate::monitor::MARGIN_MAX`] for loads below the minimum; 0 once `brake_degraded` rose
-    /// (the pack let a load through: it holds less than the load).
+    /// Holding capacity over the largest expected load (`max_load_nm`), scaled by the pack
+    /// health; 0 once the pack was seen holding less than a load it met ([`Flags::pack_weak`]).
     pub capacity_margin: Q16,
+    /// Its lower bound: the model's spread (`capacity_uncertainty`) taken off, health above 1
+    /// not credited.
+    pub capacity_margin_low: Q16,
     /// Pack health: measured over model braking torque while slipping (1.0 nominal).
     pub pack_health: Q16,
     /// Friction energy dissipated in the pack since power-on (J).
@@ -303,16 +312,26 @@ impl Estimate {
         output_speed_rad_s: Q16::ZERO,
         input_speed_rad_s: Q16::ZERO,
         capacity_margin: Q16::ZERO,
+        capacity_margin_low: Q16::ZERO,
         pack_health: Q16::ONE,
         friction_energy_j: U40F24::ZERO,
         trusted: false,
         flags: Flags::from_bits(0),
     };
 
+    /// [`Estimate::NONE`] with the capacity margin and its lower bound.
+    pub(crate) const fn with_margins((margin, low): (Q16, Q16)) -> Estimate {
+        Estimate {
+            capacity_margin: margin,
+            capacity_margin_low: low,
+            ..Estimate::NONE
+        }
+    }
+
     /// The estimate as words for streaming and digests: tick, force, braking torque, measured
-    /// braking torque, load, drive torque, output speed, input speed, margin, health (Q16 bits
-    /// as `u32`), energy low and high words, then `brake | scene << 8 | trusted << 16 |
-    /// flags << 24`, then an FNV-1a checksum of the first 13 words.
+    /// braking torque, load, drive torque, output speed, input speed, margin, its lower bound,
+    /// health (Q16 bits as `u32`), energy low and high words, then `brake | scene << 8 |
+    /// trusted << 16 | flags << 24`, then an FNV-1a checksum of the first 14 words.
     pub fn to_words(&self) -> [u32; ESTIMATE_WORDS] {
         let energy = self.friction_energy_j.to_bits();
         let packed = u32::from(self.brake as u8)
@@ -329,6 +348,7 @@ impl Estimate {
             self.output_speed_rad_s.to_bits() as u32,
             self.input_speed_rad_s.to_bits() as u32,
             self.capacity_margin.to_bits() as u32,
+            self.capacity_margin_low.to_bits() as u32,
             self.pack_health.to_bits() as u32,
             energy as u32,
             (energy >> 32) as u32,
@@ -340,7 +360,9 @@ impl Estimate {
                 hash = (hash ^ u32::from(byte)).wrapping_mul(0x0100_0193);
             }
         }
-        let [w0, w1, w2, w3, w4, w5, w6, w7, w8, w9, w10, w11, w12] = body;
-        [w0, w1, w2, w3, w4, w5, w6, w7, w8, w9, w10, w11, w12, hash]
+        let [w0, w1, w2, w3, w4, w5, w6, w7, w8, w9, w10, w11, w12, w13] = body;
+        [
+            w0, w1, w2, w3, w4, w5, w6, w7, w8, w9, w10, w11, w12, w13, hash,
+        ]
     }
 }

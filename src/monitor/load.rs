@@ -5,13 +5,13 @@
 //! | quantity | format | range | resolution |
 //! |---|---|---|---|
 //! | load, capacity, available | [`Q16`] N·m, saturating | ±32 768 | 1.5e-5 N·m |
-//! | margin | [`Q16`], at most [`MARGIN_MAX`] | 0 … 1000 | 1.5e-5 |
+//! | margins | [`Q16`], at most [`MARGIN_MAX`] | 0 … 1000 | 1.5e-5 |
 //! | health | [`Q16`], clamped | 0 … 2 | 1.5e-5 |
 
 use super::checks::Decel;
 use super::config::{Config, ConfigError};
-use super::convert::{filter_gain, positive, scale, ticks, Q16_ONE};
-use super::scale::{recip_q16, Scale};
+use super::convert::{filter_gain, finite, positive, q16, require, scale, ticks, Q16_ONE};
+use super::scale::Scale;
 use super::schedule::SLOW;
 use super::{mul_q16, MARGIN_MAX};
 use crate::fx::{lowpass, Gain, Q16};
@@ -31,6 +31,10 @@ pub(crate) struct LoadSettings {
     /// Learning ticks before the load counts as known (three time constants).
     known_ticks: u32,
     min_margin: Scale<26>,
+    /// A healthy pack's modelled capacity over the largest expected load (`max_load_nm`), and
+    /// its lower bound (`× (1 − capacity_uncertainty)`), each at most [`MARGIN_MAX`] / 2.
+    service_margin: Q16,
+    service_margin_low: Q16,
     /// Health change per slow-lane update (Q16 bits).
     health_step: i32,
     /// Health is learned against an opposing load too: only where the envelope counts on the
@@ -45,7 +49,15 @@ impl LoadSettings {
         let health_step = positive(t.health_rate_per_s, "thresholds.health_rate_per_s")?
             * f64::from(SLOW.ticks)
             * (1.0 / tick_hz);
-        super::convert::require(health_step < 0.5, "thresholds.health_rate_per_s")?;
+        require(health_step < 0.5, "thresholds.health_rate_per_s")?;
+        let max_load = positive(t.max_load_nm, "thresholds.max_load_nm")?;
+        let (m, mu) = (&c.mechanism, finite(c.capacity_mu, "capacity_mu")?);
+        let service = m.pack_capacity_nm(m.quasi_static_pressing_force_n(max_load), mu) / max_load;
+        // Health ≤ 2 keeps `h · service` within MARGIN_MAX.
+        let most = f64::from(MARGIN_MAX.to_bits() >> 17);
+        require(service > 0.0 && service < most, "capacity_mu")?;
+        let u = finite(t.capacity_uncertainty, "thresholds.capacity_uncertainty")?;
+        require((0.0..1.0).contains(&u), "thresholds.capacity_uncertainty")?;
         Ok(LoadSettings {
             alpha: filter_gain(hz, tick_hz, SLOW, "thresholds.load_filter_hz")?,
             known_ticks: ticks(
@@ -57,9 +69,25 @@ impl LoadSettings {
                 positive(t.min_capacity_margin, "thresholds.min_capacity_margin")?,
                 "thresholds.min_capacity_margin",
             )?,
+            service_margin: q16(service, "capacity_mu")?,
+            service_margin_low: q16(service * (1.0 - u), "thresholds.capacity_uncertainty")?,
             health_step: ((health_step * Q16_ONE + 0.5) as i32).max(1),
             learn_opposed: t.opposed_braking_share >= 1.0,
         })
+    }
+
+    /// A healthy pack's margins (`margins` at `h` = 1).
+    pub fn healthy_margins(&self) -> (Q16, Q16) {
+        (self.service_margin, self.service_margin_low)
+    }
+
+    /// The capacity margin at the largest expected load for pack health `h`, and its lower
+    /// bound, which never credits the pack with more than its model (`min(h, 1)`).
+    pub fn margins(&self, h: Q16) -> (Q16, Q16) {
+        (
+            mul_q16(h, self.service_margin),
+            mul_q16(h.min(Q16::ONE), self.service_margin_low),
+        )
     }
 }
 
@@ -92,8 +120,8 @@ impl LoadEstimate {
     }
 }
 
-/// Capacity, reciprocal and margin floor for one load value, recomputed when it changes;
-/// `available` and `margin` for one health value.
+/// Capacity and margin floor for one load value, recomputed when it changes; `available` for
+/// one health value.
 #[cfg_attr(
     feature = "config-block",
     derive(serde::Serialize, serde::Deserialize, Hash)
@@ -106,14 +134,11 @@ pub(crate) struct LoadCache {
     pub capacity: Q16,
     /// The braking envelope's deceleration torques.
     pub decel: Decel,
-    recip: Q16,
     /// `min_capacity_margin · |M̂|`.
     pub margin_floor: Q16,
     health: Q16,
     /// `health · capacity`.
     pub available: Q16,
-    /// `available / |M̂|`, at most [`MARGIN_MAX`].
-    pub margin: Q16,
 }
 
 /// The load stage's state.
@@ -149,11 +174,9 @@ impl Load {
                     along: Q16::ZERO,
                     opposed: Q16::ZERO,
                 },
-                recip: Q16::ZERO,
                 margin_floor: Q16::ZERO,
                 health: Q16::ONE,
                 available: Q16::ZERO,
-                margin: Q16::ZERO,
             },
             alt: None,
         }
@@ -202,11 +225,9 @@ impl Load {
             alt: self.alt,
             capacity,
             decel,
-            recip: Q16::from_bits(recip_q16(load_abs.to_bits())),
             margin_floor: Q16::from_bits(k.min_margin.apply(load_abs.to_bits())),
             health: self.health,
             available: Q16::ZERO,
-            margin: Q16::ZERO,
         };
         self.cache_health();
     }
@@ -242,12 +263,11 @@ impl Load {
         }
     }
 
-    /// `available` and `margin` for the present health (two products).
+    /// `available` for the present health.
     fn cache_health(&mut self) {
         let c = &mut self.cache;
         c.health = self.health;
         c.available = mul_q16(self.health, c.capacity);
-        c.margin = mul_q16(c.available, c.recip).min(MARGIN_MAX);
     }
 }
 

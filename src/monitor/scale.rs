@@ -1,5 +1,5 @@
-//! Constant multipliers and the reciprocal: the only arithmetic the 10 kHz step needs besides
-//! additions.
+//! Constant multipliers: the only arithmetic the 10 kHz step needs besides additions and
+//! `mul_q16`.
 //!
 //! Every physical constant the step multiplies by (gains, unit conversions, `h/J_s`, …) is
 //! converted once, in `Monitor::new`, into a [`Scale<S>`]: a 32-bit mantissa with the binary
@@ -11,9 +11,6 @@
 //! **saturated** to `i32` (the inputs are physical quantities: a clipped value is the safe
 //! answer). With `S ≥ 32` the result is below 2^30 and cannot saturate, and the shift is the
 //! product's high word plus one 32-bit shift: about 6 instructions on Cortex-M3.
-//!
-//! [`recip_q16`] gives `1/x` in Q16 by Newton–Raphson on a normalised mantissa, so the step
-//! has no division (a software division costs ~100 instructions on Cortex-M0).
 
 pub use crate::fx::sat_i32;
 /// Why a constant does not fit a [`Scale<S>`].
@@ -111,51 +108,6 @@ impl<const S: u32> Scale<S> {
     }
 }
 
-/// `1/x` for a positive Q16 value given by its bits, as Q16 bits, **saturating** at `i32::MAX`
-/// (1/x ≥ 32 768, i.e. x ≤ 2^-15); `x ≤ 0` gives `i32::MAX` too (callers pass magnitudes).
-///
-/// Method: normalise `x = f·2^(32−n−16)` with `f ∈ [½, 1)` (count leading zeros), start from the
-/// minimax line `48/17 − 32/17·f` (error ≤ 1/17), and take three Newton steps
-/// `y ← y·(2 − f·y)` in Q30 (error squares each step: 1/17 → 3.5e-3 → 1.2e-5 → 1.5e-10).
-/// Error ≤ 1 LSB + 2^-27 relative (tested against f64).
-///
-/// ```
-/// use noback::monitor::recip_q16;
-/// let half = recip_q16(2 << 16);           // 1/2
-/// assert!((half - (1 << 15)).abs() <= 1);
-/// assert_eq!(recip_q16(1), i32::MAX);      // 1/2^-16 = 65 536 does not fit Q16
-/// ```
-pub fn recip_q16(x: i32) -> i32 {
-    if x <= 0 {
-        return i32::MAX;
-    }
-    let xu = x as u32; // x > 0
-    let n = xu.leading_zeros(); // 1..=31
-    let m = xu << n; // f = m / 2^32 ∈ [½, 1)
-    const ONE_Q30: u32 = 1 << 30;
-    // y0 = 48/17 − 32/17·f in Q30 (constants folded at compile time: no run-time division).
-    const C48: u32 = ((48 * ONE_Q30 as u64) / 17) as u32;
-    const C32: u32 = ((32 * ONE_Q30 as u64) / 17) as u32;
-    // Every operand is a u32 and every product u32 × u32 → u64 (one UMULL on Cortex-M3/M4):
-    // y stays in (0, 2^31] (Newton for 1/f approaches from below, and 1/f ≤ 2), so the
-    // narrowing casts below are exact.
-    let wide_mul = |a: u32, b: u32| u64::from(a) * u64::from(b);
-    let mut y = C48 - (wide_mul(C32, m) >> 32) as u32;
-    for _ in 0..3 {
-        let fy = (wide_mul(m, y) >> 32) as u32; // f·y in Q30, ≈ 2^30
-        let two_minus = (2 * ONE_Q30).saturating_sub(fy);
-        y = (wide_mul(y, two_minus) >> 30) as u32;
-    }
-    // 1/x_value = 2^16 · 2^32 / (x·2^16) … in Q16 bits: 2^32/x = 2^n / f = y·2^(n−30).
-    let y = u64::from(y);
-    let wide = if n >= 30 {
-        y << (n - 30)
-    } else {
-        y >> (30 - n)
-    };
-    i32::try_from(wide).unwrap_or(i32::MAX)
-}
-
 #[cfg(test)]
 mod tests {
     extern crate std;
@@ -185,29 +137,5 @@ mod tests {
         let big = Scale::<16>::from_f64(1000.0).unwrap_or(Scale::ZERO);
         assert_eq!(big.apply(i32::MIN), i32::MIN);
         assert_eq!(big.apply(-2_000), -2_000_000);
-    }
-
-    #[test]
-    fn recip_is_close() {
-        for bits in [
-            1_i32,
-            2,
-            3,
-            100,
-            65_535,
-            65_536,
-            65_537,
-            1 << 20,
-            1_330_000,
-            i32::MAX,
-        ] {
-            let exact = 65_536.0 * 65_536.0 / f64::from(bits);
-            let got = f64::from(recip_q16(bits));
-            let want = exact.min(f64::from(i32::MAX));
-            assert!(
-                (got - want).abs() <= 1.0 + want * 7.5e-9,
-                "{bits}: {got} vs {want}"
-            );
-        }
     }
 }

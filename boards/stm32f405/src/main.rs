@@ -38,6 +38,8 @@ mod app {
     use fugit::TimerDurationU32;
     use noback::app::Ticker;
     #[cfg(feature = "hw")]
+    use noback::monitor::Settings;
+    #[cfg(feature = "hw")]
     use noback::monitor::{config_block, Monitor};
     use stm32f4xx_hal::gpio::{Output, PA10};
     use stm32f4xx_hal::pac;
@@ -156,7 +158,8 @@ mod app {
     }
 
     /// Builds the application in `slot` on `block`'s settings, where they were decoded: one copy
-    /// of them on the stack, none of the monitor (the part's stack budget).
+    /// of them on the stack while the decoder runs, the monitor built after it returned (the
+    /// part's stack budget).
     #[cfg(feature = "hw")]
     #[inline(never)]
     fn install(
@@ -165,14 +168,21 @@ mod app {
         source: io::Source,
         alarm: PA10<Output>,
     ) -> &'static mut App {
-        let built = config_block::read(block, |settings| {
-            slot.write(Ticker::new(
-                Monitor::with_settings(*settings),
-                source,
-                alarm,
-            ))
-        });
+        let built = config_block::read(block, |settings| build(slot, settings, source, alarm));
         built.unwrap_or_else(|_| clock::halt("the configuration block does not decode"))
+    }
+
+    /// The application on decoded settings: out of line, so its temporaries are not on the
+    /// stack beside the decoder's.
+    #[cfg(feature = "hw")]
+    #[inline(never)]
+    fn build(
+        slot: &'static mut MaybeUninit<App>,
+        settings: &Settings,
+        source: io::Source,
+        alarm: PA10<Output>,
+    ) -> &'static mut App {
+        slot.write(Ticker::new(Monitor::with_settings(settings), source, alarm))
     }
 
     /// Feeds the sample ring (under QEMU) and prints the log; at a trace's end, the summary.
