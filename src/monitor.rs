@@ -493,11 +493,7 @@ impl State {
         self.flags = self.flags.union(raised);
         self.fault_latched |= raised.distrusts();
         if raised.pack_weak() {
-            // From this tick on (the Estimate slot keeps them 0).
-            (
-                self.estimate.capacity_margin,
-                self.estimate.capacity_margin_low,
-            ) = (Q16::ZERO, Q16::ZERO);
+            self.estimate.drop_margins(); // from this tick on; the Estimate slot keeps them 0
         }
     }
 

@@ -328,6 +328,11 @@ impl Estimate {
         }
     }
 
+    /// No margin claimed: the pack was seen holding less than a load it met.
+    pub(crate) fn drop_margins(&mut self) {
+        (self.capacity_margin, self.capacity_margin_low) = (Q16::ZERO, Q16::ZERO);
+    }
+
     /// The estimate as words for streaming and digests: tick, force, braking torque, measured
     /// braking torque, load, drive torque, output speed, input speed, margin, its lower bound,
     /// health (Q16 bits as `u32`), energy low and high words, then `brake | scene << 8 |
