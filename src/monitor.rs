@@ -190,7 +190,7 @@ impl Monitor {
                 observed: Observed::NONE,
                 load,
                 // A healthy pack's margins until the first classification.
-                estimate: Estimate::with_margins(settings.load.healthy_margins()),
+                estimate: Estimate::with_margins(settings.load.margins(Q16::ONE)),
                 energy: Energy::new(),
                 checks: Checks::new(),
                 flags: Flags::default(),

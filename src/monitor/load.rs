@@ -76,11 +76,6 @@ impl LoadSettings {
         })
     }
 
-    /// A healthy pack's margins (`margins` at `h` = 1).
-    pub fn healthy_margins(&self) -> (Q16, Q16) {
-        (self.service_margin, self.service_margin_low)
-    }
-
     /// The capacity margin at the largest expected load for pack health `h`, and its lower
     /// bound, which never credits the pack with more than its model (`min(h, 1)`).
     pub fn margins(&self, h: Q16) -> (Q16, Q16) {
