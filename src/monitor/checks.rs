@@ -243,6 +243,7 @@ impl Checks {
                     carrying: c.scene == Scene::Driving,
                     load_ref: load.reference,
                     pending: c.pending,
+                    guessed: c.guessed,
                     ticks: x.n,
                     settle_ticks: i.settle_ticks,
                 };

@@ -90,8 +90,8 @@ pub struct Thresholds {
     /// … plus this allowance (rad), before `brake_weak`.
     pub braking_angle_allowance_rad: f64,
     /// Braking envelope, a brake that does not brake: the output's travel since the cut may
-    /// exceed what it would cover at its cut speed, undecelerated, by this much (rad) before
-    /// `brake_weak` (a working pack decelerates it from the first millisecond).
+    /// exceed what it would cover at its observed cut speed, undecelerated, by this much (rad)
+    /// before `brake_weak`: a working pack's lost motion and the observer's lag behind a chatter.
     pub undecelerated_allowance_rad: f64,
     /// Braking against an opposing load: the share of the pack's capacity the nominal braking
     /// model counts on (0 … 1). Uncommissioned 0 (the paper reading's ramps clamp only once the
@@ -192,7 +192,7 @@ impl Thresholds {
         braking_grace_s: 0.4,
         braking_angle_factor: 4.0, // the paper reading at μ_d: ≤ 2.7× the model's angle
         braking_angle_allowance_rad: 0.3, // the paper reading's pack: ≤ 0.2 rad past the model
-        undecelerated_allowance_rad: 0.01,
+        undecelerated_allowance_rad: 0.03, // 1.5× a chatter's gain at the cut (≤ 0.02 rad)
         opposed_braking_share: 0.0, // the paper reading: only the load slows the output
         min_capacity_margin: 1.5,
         capacity_uncertainty: 0.22, // Table 2 ± 10 %: 2.5 % of plants hold less than 0.79×

@@ -116,7 +116,7 @@ mod tests {
         let crc = u32::from_le_bytes(buf[n - 4..n].try_into().unwrap());
         assert_eq!(
             (n, crc),
-            (299, 0xA7A7_20CF),
+            (301, 0x2A44_969F),
             "length and CRC of the default block"
         );
     }

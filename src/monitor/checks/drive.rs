@@ -46,6 +46,9 @@ pub(crate) struct DriveSettings {
     drive_ref_shift: u32,
     /// Gain of the implied load's history, in the slow lane.
     step_alpha: Gain,
+    /// The history's time constant (ticks): a history seeded on a guessed reading judges no
+    /// lighter step before it has followed this long.
+    history_ticks: u32,
 }
 
 impl DriveSettings {
@@ -88,6 +91,11 @@ impl DriveSettings {
             )?,
             drive_ref_shift: nearest_shift(alpha),
             step_alpha: gain(alpha, "thresholds.step_reference_hz")?,
+            history_ticks: ticks(
+                1.0 / (core::f64::consts::TAU * t.step_reference_hz),
+                tick_hz,
+                "thresholds.step_reference_hz",
+            )?,
         })
     }
 }
@@ -107,6 +115,9 @@ pub(crate) struct DriveChecks {
     drive_ref: Q16,
     /// The history has been seeded in this phase of the drive.
     step_ref_valid: bool,
+    /// Ticks the history has followed since it was seeded on a guessed reading (saturating;
+    /// seeded on a decided one, it starts at the time constant).
+    followed_ticks: u32,
     /// Ticks the drive has worked harder than its history by more than the step limit.
     step_up_ticks: u32,
     /// Ticks it has seemed to work less (current reading low).
@@ -140,6 +151,8 @@ pub(crate) struct DriveTick {
     /// (its harder half only when the change is away from overrunning), the history is not
     /// updated and the drag check waits for the reading to settle.
     pub pending: bool,
+    /// The reading is a guess (taken with no load known while the other fits the current too).
+    pub guessed: bool,
     /// Ticks since the previous step.
     pub ticks: u32,
     /// The observer's settling after a change of the pack's reading (`engage_settle_s`).
@@ -233,9 +246,14 @@ impl DriveChecks {
             });
             let needed = share.max(p.step_drive_min);
             let drive_step = t.drive.saturating_sub(self.drive_ref);
+            // A history seeded on a guess (a power-on into a running drive) may hold the
+            // servo's settling: no lighter step until it has followed for its time constant.
+            self.followed_ticks = self.followed_ticks.saturating_add(counted);
             let (harder, lighter) = (
                 harder && drive_step > needed,
-                lighter && drive_step < needed.saturating_neg(),
+                lighter
+                    && drive_step < needed.saturating_neg()
+                    && self.followed_ticks >= p.history_ticks,
             );
             // The harder half waits out a pending change towards overrunning (the light-load
             // chatter of continuous closing pulses the drive torque by 9 N·m and makes the
@@ -274,6 +292,7 @@ impl DriveChecks {
             self.step_ref = along;
             self.drive_ref = t.drive;
             self.step_ref_valid = true;
+            self.followed_ticks = if t.guessed { 0 } else { p.history_ticks };
         }
         // Drag against the drive's start: the load the current implies with a nominal drag
         // beyond the envelope, or the pack torque beyond the reference load by the allowance.
@@ -331,6 +350,7 @@ mod tests {
             carrying: true,
             load_ref: None,
             pending,
+            guessed: false,
             ticks: 1,
             settle_ticks: settings().scene.engage_settle_ticks,
         }
@@ -370,6 +390,23 @@ mod tests {
         run(&mut c, &carrying(20.0, false), 100);
         let f = run(&mut c, &carrying(15.0, false), 26);
         assert!(f.sensor_fault && !f.brake_drag, "{f:?}");
+    }
+
+    #[test]
+    fn a_history_seeded_on_a_guess_judges_no_lighter_step_before_its_time_constant() {
+        // 5 Hz: 31.8 ms, 318 ticks, 80 runs. Seeded on a guess, a lost gain 20 runs in is
+        // held until then and called 25 runs after; seeded on a decided reading, at once.
+        let guessed = |drive| DriveTick {
+            guessed: true,
+            ..carrying(drive, false)
+        };
+        let mut c = DriveChecks::default();
+        run(&mut c, &guessed(20.0), 20);
+        assert!(!run(&mut c, &guessed(15.0), 60).sensor_fault);
+        assert!(run(&mut c, &guessed(15.0), 26).sensor_fault);
+        let mut c = DriveChecks::default();
+        run(&mut c, &carrying(20.0, false), 20);
+        assert!(run(&mut c, &carrying(15.0, false), 26).sensor_fault);
     }
 
     #[test]
