@@ -115,9 +115,9 @@ pub(crate) struct DriveChecks {
     drive_ref: Q16,
     /// The history has been seeded in this phase of the drive.
     step_ref_valid: bool,
-    /// Ticks the history has followed since it was seeded on a guessed reading (saturating;
-    /// seeded on a decided one, it starts at the time constant).
-    followed_ticks: u32,
+    /// Ticks a history seeded on a guessed reading still waits before it judges a lighter step
+    /// (its time constant at the seeding, 0 on a decided reading).
+    guess_wait_ticks: u32,
     /// Ticks the drive has worked harder than its history by more than the step limit.
     step_up_ticks: u32,
     /// Ticks it has seemed to work less (current reading low).
@@ -248,12 +248,10 @@ impl DriveChecks {
             let drive_step = t.drive.saturating_sub(self.drive_ref);
             // A history seeded on a guess (a power-on into a running drive) may hold the
             // servo's settling: no lighter step until it has followed for its time constant.
-            self.followed_ticks = self.followed_ticks.saturating_add(counted);
+            self.guess_wait_ticks = self.guess_wait_ticks.saturating_sub(counted);
             let (harder, lighter) = (
                 harder && drive_step > needed,
-                lighter
-                    && drive_step < needed.saturating_neg()
-                    && self.followed_ticks >= p.history_ticks,
+                lighter && drive_step < needed.saturating_neg() && self.guess_wait_ticks == 0,
             );
             // The harder half waits out a pending change towards overrunning (the light-load
             // chatter of continuous closing pulses the drive torque by 9 N·m and makes the
@@ -292,7 +290,7 @@ impl DriveChecks {
             self.step_ref = along;
             self.drive_ref = t.drive;
             self.step_ref_valid = true;
-            self.followed_ticks = if t.guessed { 0 } else { p.history_ticks };
+            self.guess_wait_ticks = if t.guessed { p.history_ticks } else { 0 };
         }
         // Drag against the drive's start: the load the current implies with a nominal drag
         // beyond the envelope, or the pack torque beyond the reference load by the allowance.
