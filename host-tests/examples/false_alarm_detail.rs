@@ -1,6 +1,6 @@
 //! One healthy plant-family run read closely: its draw, every flag with its time, which check
 //! raised the first (the first flag gone with that check's threshold out of reach), and the
-//! monitor's estimate over the 20 ms before it (docs/decisions.md, "The plant family's false
+//! monitor's estimate over the 20 ms before it (`DETAIL_MS` for longer) (docs/decisions.md, "The plant family's false
 //! alarms at tuning seed 4242").
 //!
 //! `cargo run --release -p host-tests --example false_alarm_detail -- SEED RUN [RUN …]`
@@ -27,6 +27,16 @@ const CHECKS: [(&str, SwitchOff); 7] = [
     ("stuck counter", |t| t.max_lost_motion_rad = 100.0),
     ("dead current", |t| t.dead_current_nm = 1e-3),
 ];
+
+/// Samples shown before the first flag and the stride: 20 ms every 1 ms, or `DETAIL_MS`
+/// milliseconds in about 40 lines.
+fn window() -> (usize, usize) {
+    let ms: usize = std::env::var("DETAIL_MS")
+        .ok()
+        .and_then(|v| v.parse().ok())
+        .unwrap_or(20);
+    (ms * 10, (ms * 10 / 40).max(10))
+}
 
 fn main() -> Result<(), String> {
     let args: Vec<u64> = std::env::args()
@@ -79,7 +89,8 @@ fn main() -> Result<(), String> {
             }
         }
         let at = (first.t_s * trace.sample_rate_hz).round() as usize;
-        for k in (at.saturating_sub(200)..=at.min(est.len().saturating_sub(1))).step_by(10) {
+        let (span, every) = window();
+        for k in (at.saturating_sub(span)..=at.min(est.len().saturating_sub(1))).step_by(every) {
             let (e, r) = (&est[k], &trace.rows[k]);
             println!(
                 "  {:.4} {:?} {:?} load {:7.3} brake {:7.3} meas {:7.3} drive {:7.3} w {:7.3} win {:7.3} | twin w_out {:7.3} brake {:7.3} state {}",

@@ -237,3 +237,24 @@ fn the_servos_settling_after_a_power_on_guess_is_no_lost_gain() {
     let acc = family_monitor(&trace);
     assert!(acc.flags.is_empty(), "{:?}", acc.flag_times());
 }
+
+/// Tuning seed 4242's run 26510 (paper form, reverse load 24.8 N·m): after the door stops the
+/// load turns it back, and the pack, slipping at μ_d only ≈ 13 % above the load, slows it from
+/// 3.4 rad/s over ≈ 0.2 s. It travels past twice the creep limit while still slowing: braking,
+/// not a slip (`brake_slip` at 0.47 s before the slowing windows).
+#[test]
+fn a_turn_back_the_pack_keeps_slowing_is_no_slip() {
+    let (d, trace) = family_draw(4242, 26510);
+    assert!(d.scene.faults.is_empty());
+    let cut = d.scene.release_at_s.expect("a cut");
+    let after: Vec<_> = trace.rows.iter().filter(|r| r.t_s > cut).collect();
+    let stop = after
+        .windows(2)
+        .position(|w| w[0].output_speed_rad_s * w[1].output_speed_rad_s <= 0.0)
+        .expect("the door stops");
+    let angles = after[stop..].iter().map(|r| r.output_angle_rad);
+    let span = angles.clone().fold(f64::MIN, f64::max) - angles.fold(f64::MAX, f64::min);
+    let limit = Family::Plant.config().thresholds.creep_limit_rad;
+    assert!(span > 2.0 * limit, "turned back {span} rad");
+    assert!(family_monitor(&trace).flags.is_empty());
+}

@@ -210,7 +210,7 @@ impl Checks {
             };
             raised.brake_weak = self.weak_ticks >= k.persistence_ticks;
             if !drive {
-                self.hold.track_speed(o.w.to_bits());
+                self.hold.track_speed(&k.hold, o.w.to_bits(), x.n);
                 gave_way = self.hold.common_slip(&k.hold, x.out, x.motor);
                 raised.brake_slip = gave_way;
             }

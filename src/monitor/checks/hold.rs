@@ -1,17 +1,22 @@
 //! The held brake (`brake_slip`): the span of the output's travel since the brake first held
 //! (creep: rattling inside the lost motion keeps it bounded, a slipping pack grows it), and
 //! both shafts carried the same way (`slip.rs`, sooner for a slow slip). A span travelled
-//! while the output decelerates (a load turning it back until the ramps clamp) is a braking,
-//! allowed twice the creep limit.
+//! while the output decelerates (a load turning it back until the ramps clamp) is a braking:
+//! allowed twice the creep limit, and beyond it while |ω̂| keeps falling window by window.
 //!
 //! | quantity | format | range | resolution |
 //! |---|---|---|---|
 //! | creep span | `i32` counts, saturating | ±2^31 | 1 count |
-//! | peak speed | `i32` Q16 rad/s bits, saturating | 0 … 32 768 | 1.5e-5 rad/s |
+//! | peak speed, window speed | `i32` Q16 rad/s bits, saturating | 0 … 32 768 | 1.5e-5 rad/s |
 
 use super::slip::{SlipCheck, SlipLimits};
 use crate::monitor::config::{Config, ConfigError};
-use crate::monitor::convert::{counts, positive};
+use crate::monitor::convert::{counts, positive, q16, ticks};
+use crate::monitor::schedule::SLOW;
+
+/// A braked turn-back past twice the creep limit must slow by 1/16 of its speed in each
+/// window this long (at least an exponential decay of 0.32 s: the travel left stays bounded).
+const SLOWING_WINDOW_S: f64 = 0.02;
 
 /// The held brake's constants.
 #[cfg_attr(
@@ -21,6 +26,11 @@ use crate::monitor::convert::{counts, positive};
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub(crate) struct HoldSettings {
     creep_counts: i32,
+    /// Ticks of one slowing window ([`SLOWING_WINDOW_S`]).
+    slowing_ticks: u32,
+    /// Below this |ω̂| (Q16 bits, ⅛ of the stick speed: the observer at rest) the output has
+    /// stopped; a creep past twice the limit slower than the stick speed is still called.
+    stopped_speed: i32,
     slip: SlipLimits,
 }
 
@@ -32,6 +42,15 @@ impl HoldSettings {
                 positive(c.thresholds.creep_limit_rad, "thresholds.creep_limit_rad")? / out_rad,
                 "thresholds.creep_limit_rad",
             )?,
+            slowing_ticks: ticks(SLOWING_WINDOW_S, c.tick_hz, "tick_hz")?,
+            stopped_speed: q16(
+                positive(
+                    c.thresholds.stick_speed_rad_s,
+                    "thresholds.stick_speed_rad_s",
+                )? / 8.0,
+                "thresholds.stick_speed_rad_s",
+            )?
+            .to_bits(),
             slip: SlipLimits::new(c)?,
         })
     }
@@ -51,6 +70,11 @@ pub(crate) struct HoldChecks {
     creep_max: i32,
     /// Highest |ω̂| since the span started (Q16 bits).
     peak_speed: i32,
+    /// |ω̂| at the last window's end (Q16 bits), ticks into this window, and whether the
+    /// last window ended slower by 1/16 or stopped.
+    window_speed: i32,
+    window_ticks: u32,
+    slowing: bool,
     slip: SlipCheck,
 }
 
@@ -71,7 +95,7 @@ impl HoldChecks {
         if !self.creep_valid {
             self.creep_valid = true;
             (self.creep, self.creep_min, self.creep_max) = (0, 0, 0);
-            self.peak_speed = 0;
+            self.restart_speed();
             self.slip.arm(out, motor);
         }
     }
@@ -79,12 +103,18 @@ impl HoldChecks {
     /// `reset_flags`: the span is measured afresh (a reset while holding keeps the checks armed).
     pub fn restart(&mut self, out: u32, motor: u32) {
         (self.creep, self.creep_min, self.creep_max) = (0, 0, 0);
-        self.peak_speed = 0;
+        self.restart_speed();
         self.slip.restart(out, motor);
     }
 
+    fn restart_speed(&mut self) {
+        (self.peak_speed, self.window_speed, self.window_ticks) = (0, 0, 0);
+        self.slowing = false;
+    }
+
     /// Creep, every call with the drive off and a plausible output step `d_out`, with the
-    /// observer's speed `w` (Q16 bits): decelerating = below ⅞ of the peak |ω̂| since the hold.
+    /// observer's speed `w` (Q16 bits): braking = below ⅞ of the peak |ω̂| since the hold, and
+    /// past twice the limit still slowing.
     pub fn creep(&mut self, k: &HoldSettings, d_out: i32, w: i32) -> bool {
         if !self.creep_valid {
             return false;
@@ -93,20 +123,28 @@ impl HoldChecks {
         self.creep_min = self.creep_min.min(self.creep);
         self.creep_max = self.creep_max.max(self.creep);
         let span = self.creep_max.saturating_sub(self.creep_min);
-        // Past the creep limit: slipped unless decelerating and within the braking span.
+        // Past the creep limit: slipped unless braking.
         let slipped = span > k.creep_counts
-            && (span > k.creep_counts.saturating_mul(2)
-                || w.saturating_abs() >= self.peak_speed.saturating_sub(self.peak_speed >> 3));
+            && (w.saturating_abs() >= self.peak_speed.saturating_sub(self.peak_speed >> 3)
+                || (span > k.creep_counts.saturating_mul(2) && !self.slowing));
         if slipped {
             self.creep_valid = false;
         }
         slipped
     }
 
-    /// The peak |ω̂| since the hold, on the slow lane's checks slot with the drive off (the
-    /// creep check reads it only past its limit).
-    pub fn track_speed(&mut self, w: i32) {
-        self.peak_speed = self.peak_speed.max(w.saturating_abs());
+    /// The peak |ω̂| since the hold and the slowing windows, on the slow lane's checks slot with
+    /// the drive off, `n` ticks since the last call (the creep check reads them past its limit).
+    pub fn track_speed(&mut self, k: &HoldSettings, w: i32, n: u32) {
+        let speed = w.saturating_abs();
+        self.peak_speed = self.peak_speed.max(speed);
+        self.window_ticks = self.window_ticks.saturating_add(SLOW.covered(n));
+        if self.window_ticks >= k.slowing_ticks {
+            self.window_ticks = 0;
+            self.slowing = speed < k.stopped_speed
+                || speed <= self.window_speed.saturating_sub(self.window_speed >> 4);
+            self.window_speed = speed;
+        }
     }
 
     /// The common-slip check, on its slow-lane slot with the drive off.
@@ -133,7 +171,9 @@ mod tests {
         h.locked(0, 0);
         (0..4_000_u32).find_map(|t| {
             let bits = (w(t) * 65_536.0) as i32;
-            h.track_speed(bits);
+            if SLOW.slot(t) == 0 {
+                h.track_speed(&k, bits, 1);
+            }
             h.creep(&k, 1, bits)
                 .then(|| f64::from(h.creep_max - h.creep_min) * c.sensors.output_rad_per_count())
         })
@@ -155,5 +195,27 @@ mod tests {
             (2.0 * limit..2.0 * limit * 1.01).contains(&braking),
             "{braking}"
         );
+    }
+
+    #[test]
+    fn a_turn_back_that_keeps_slowing_is_braking_past_twice_the_limit() {
+        let limit = Config::default().thresholds.creep_limit_rad;
+        // 4 rad/s, then slowing at 20 rad/s² to a stop (a pack at μ_d barely above the load):
+        // never called, though it travels past twice the limit.
+        let slowing = |t: u32| (4.0 - 20.0 * (f64::from(t) - 100.0).max(0.0) / 1e4).max(0.0);
+        assert_eq!(slip_at(slowing), None);
+        let rad_per_count = Config::default().sensors.output_rad_per_count();
+        assert!(2_100.0 * rad_per_count > 2.0 * limit); // the travel to the stop
+                                                        // Slowing to 2 rad/s and then carried steadily: called within a window of going steady.
+        let steady_after = slip_at(|t| slowing(t).max(2.0)).unwrap_or(0.0);
+        assert!(steady_after > 2.0 * limit, "{steady_after}");
+        let steady_from = 100.0 + 2.0 / 20.0 * 1e4; // ticks, one count each
+        assert!(
+            steady_after < (steady_from + 2.0 * 200.0) * rad_per_count,
+            "{steady_after}"
+        );
+        // Slowing to a creep below the stick speed (0.2 rad/s): called too, a window after.
+        let creep_after = slip_at(|t| slowing(t).max(0.2)).unwrap_or(0.0);
+        assert!(creep_after > 2.0 * limit, "{creep_after}");
     }
 }
