@@ -16,26 +16,31 @@
 //! 5. The shipped monitor's cost (`cargo xtask run`'s replay on the M3).
 //!
 //! Writes `docs/results/speed-accuracy.csv` and `.svg`, `docs/results/stability.csv` and
-//! `.svg`, `docs/results/cheapest-per-scene.md`, `docs/results/cost-by-core.md`.
+//! `.svg`, `docs/results/cheapest-per-scene.md`, `docs/results/cost-by-core.md` (instruction
+//! counts and errors: the same bytes on every run) and the benchmark page
+//! `docs/results/host-speed.md` (host wall times, with the machine); with `--json`, only prints.
 
 pub mod charts;
 pub mod explicit;
+mod host_speed;
+mod pages;
+mod stability_map;
+mod variants;
 pub mod work_precision;
+
+use variants::{
+    criterion_ns, errors, reference, run_criterion, run_quasi_static, run_reduced_by_name, Errors,
+    Row, FORMATS,
+};
 
 use crate::cores::Core;
 use crate::qemu::{self, Boot};
-use crate::shell::{self, cargo, workspace_root};
-use explicit::{Explicit, Verdict};
-use fixed::types::{I16F16, I32F32};
-use noback::mechanism::TABLE2;
-use noback_study::reduced::num::{Real, Widen};
-use noback_study::reduced::{BrakingScene, Method, Params, Reduced};
-use noback_twin::model::physical::Physical;
+use crate::shell::workspace_root;
+use noback_study::reduced::{BrakingScene, Method};
 use noback_twin::model::Sample;
 use noback_twin::reading::Reading;
 use noback_twin::scene::{Scene, SceneKind};
-use noback_twin::sim::{model_config, run, run_model};
-use std::fmt::Write as _;
+use noback_twin::sim::run;
 use std::time::Instant;
 
 /// The label of the quasi-static candidate in the tables (the monitor's
@@ -48,228 +53,6 @@ pub const EQUILIBRIUM_LABEL: &str = "quasi-static equilibrium";
 pub const RATES: [u32; 6] = [1_000, 2_000, 5_000, 10_000, 20_000, 50_000];
 /// Tightest tolerance of the twin: the reference.
 pub const REF_TOL: f64 = 1e-10;
-/// Speed below which the output counts as stopped (the twin's metric threshold).
-const STOP_RAD_S: f64 = 0.05;
-/// The monitor's accuracy targets a variant must meet (docs/monitor-design.md: speed within
-/// 0.5 rad/s, holding torque within 5 %; lock seen within ~9 ms there, 10 ms here).
-pub const TARGET_SPEED_RMS: f64 = 0.5;
-/// Pressing-force RMS target (% of the loaded force).
-pub const TARGET_FORCE_PCT: f64 = 5.0;
-/// Lock-time target (s).
-pub const TARGET_LOCK_S: f64 = 0.01;
-/// Holding-torque target (relative).
-pub const TARGET_HOLD_REL: f64 = 0.05;
-
-/// The formats measured, by name.
-pub const FORMATS: [&str; 5] = ["f64", "f32", "I16F16", "I32F32", "I16F16+I32F32"];
-
-/// Errors of one reduced run against the reference.
-#[derive(Clone, Copy, Debug, Default)]
-pub struct Errors {
-    /// Output-angle RMS (rad).
-    pub angle_rms: f64,
-    /// Output-speed RMS (rad/s).
-    pub speed_rms: f64,
-    /// Pressing-force RMS (% of the loaded quasi-static force).
-    pub force_rms_pct: f64,
-    /// Braking-torque RMS (N·m).
-    pub torque_rms: f64,
-    /// |lock time − reference lock time| (s); 1.0 if either never locks.
-    pub lock_err_s: f64,
-    /// Holding torque at the end relative error.
-    pub hold_rel: f64,
-}
-
-impl Errors {
-    /// Meets the monitor's accuracy targets.
-    pub fn meets_targets(&self) -> bool {
-        self.speed_rms <= TARGET_SPEED_RMS
-            && self.force_rms_pct <= TARGET_FORCE_PCT
-            && self.lock_err_s <= TARGET_LOCK_S
-            && self.hold_rel <= TARGET_HOLD_REL
-    }
-}
-
-/// One recorded instant: (t, angle, speed, force, torque).
-type Row = (f64, f64, f64, f64, f64);
-
-/// Runs a reduced variant on a braking scene for `duration_s`, recording every
-/// `max(1/rate, 1e-4)` s.
-pub fn run_reduced<N: Real + Widen<A>, A: Real>(
-    method: Method,
-    scene: BrakingScene,
-    rate: u32,
-    duration_s: f64,
-) -> Vec<Row> {
-    let p = Params::from_mechanism(&TABLE2, TABLE2.load_torque_nm, f64::from(rate));
-    let mut m = Reduced::<N, A>::new(p, method);
-    m.set_drive(true, scene.speed_ref_rad_s);
-    let cut = scene.release_tick(rate);
-    let steps = (duration_s * f64::from(rate)).round() as u32;
-    let every = (rate / 10_000).max(1);
-    let mut rows = Vec::with_capacity(steps as usize / every as usize + 1);
-    let rec = |m: &Reduced<N, A>, t: f64, rows: &mut Vec<Row>| {
-        let o = m.output();
-        rows.push((
-            t,
-            m.state.theta.to_f64(),
-            m.state.omega.to_f64(),
-            o.pressing_n.to_f64(),
-            o.braking_nm.to_f64(),
-        ));
-    };
-    rec(&m, 0.0, &mut rows);
-    for k in 0..steps {
-        if k == cut {
-            m.set_drive(false, 0.0);
-        }
-        m.step();
-        if (k + 1) % every == 0 {
-            rec(&m, f64::from(k + 1) / f64::from(rate), &mut rows);
-        }
-    }
-    rows
-}
-
-/// The quasi-static candidate: no state to advance. The output runs at the drive's speed
-/// reference while the drive is on and is at rest, held by the pack, once it is cut; force and
-/// torque are the reduced model's quasi-static outputs at that state (f64: the candidate's
-/// error is its physics, not its format). This is what the monitor does in `Holding` and
-/// `Driving`.
-pub fn run_quasi_static(scene: BrakingScene, rate: u32, duration_s: f64) -> Vec<Row> {
-    let p = Params::from_mechanism(&TABLE2, TABLE2.load_torque_nm, f64::from(rate));
-    let mut m = Reduced::<f64, f64>::new(p, Method::Euler);
-    m.set_drive(true, scene.speed_ref_rad_s);
-    let cut = scene.release_tick(rate);
-    let steps = (duration_s * f64::from(rate)).round() as u32;
-    let dt = 1.0 / f64::from(rate);
-    let mut rows = Vec::with_capacity(steps as usize + 1);
-    for k in 0..=steps {
-        if k == cut {
-            m.set_drive(false, 0.0);
-            m.state.omega = 0.0;
-        }
-        if k > 0 && k <= cut {
-            m.state.theta += scene.speed_ref_rad_s * dt;
-        }
-        let o = m.output();
-        rows.push((
-            f64::from(k) * dt,
-            m.state.theta,
-            m.state.omega,
-            o.pressing_n,
-            o.braking_nm,
-        ));
-    }
-    rows
-}
-
-fn run_reduced_by_name(
-    fmt: &str,
-    method: Method,
-    scene: BrakingScene,
-    rate: u32,
-    dur: f64,
-) -> Vec<Row> {
-    match fmt {
-        "f64" => run_reduced::<f64, f64>(method, scene, rate, dur),
-        "f32" => run_reduced::<f32, f32>(method, scene, rate, dur),
-        "I16F16" => run_reduced::<I16F16, I16F16>(method, scene, rate, dur),
-        "I32F32" => run_reduced::<I32F32, I32F32>(method, scene, rate, dur),
-        _ => run_reduced::<I16F16, I32F32>(method, scene, rate, dur),
-    }
-}
-
-/// Runs the criterion benchmark `study/benches/reduced_step.rs` (host nanoseconds per
-/// step of every format × integrator).
-fn run_criterion() -> Result<(), String> {
-    shell::run(cargo().args([
-        "bench",
-        "-p",
-        "noback-study",
-        "--bench",
-        "reduced_step",
-        "--",
-        "--noplot",
-    ]))
-}
-
-/// Criterion's mean estimate of one variant (ns per step), from its `estimates.json`.
-fn criterion_ns(fmt: &str, method: Method) -> Result<f64, String> {
-    let dir = if fmt == "I16F16+I32F32" { "mixed" } else { fmt };
-    let path = workspace_root()
-        .join("target")
-        .join("criterion")
-        .join("reduced_step")
-        .join(dir)
-        .join(method.name())
-        .join("new")
-        .join("estimates.json");
-    let text = std::fs::read_to_string(&path).map_err(|e| format!("{}: {e}", path.display()))?;
-    let v: serde_json::Value =
-        serde_json::from_str(&text).map_err(|e| format!("{}: {e}", path.display()))?;
-    v["mean"]["point_estimate"]
-        .as_f64()
-        .ok_or_else(|| format!("{}: no mean.point_estimate", path.display()))
-}
-
-/// Lock time after `release` (s): the first recorded instant after the last one at or above
-/// the stop threshold; `None` if still moving at the end.
-pub fn lock_time(rows: &[(f64, f64)], release: f64) -> Option<f64> {
-    let after: Vec<&(f64, f64)> = rows.iter().filter(|r| r.0 >= release - 1e-12).collect();
-    match after.iter().rposition(|r| r.1.abs() >= STOP_RAD_S) {
-        None => Some(0.0),
-        Some(i) => after.get(i + 1).map(|r| r.0 - release),
-    }
-}
-
-/// The reference samples of a scene (paper reading, tightest tolerance).
-pub fn reference(kind: SceneKind, reading: Reading, tol: f64) -> Result<Vec<Sample>, String> {
-    let mut scene = Scene::builtin(kind, reading);
-    scene.tolerance = tol;
-    run(&scene)
-        .map(|r| r.samples)
-        .map_err(|e| format!("twin {kind:?} at tol {tol}: {e:?}"))
-}
-
-/// Errors of reduced rows against reference samples at 10 kHz (t = i·1e-4).
-pub fn errors(rows: &[Row], reference: &[Sample], release: f64) -> Errors {
-    let f_loaded = TABLE2.quasi_static_pressing_force_n(TABLE2.load_torque_nm);
-    let (mut a, mut w, mut f, mut tq, mut n) = (0.0, 0.0, 0.0, 0.0, 0.0);
-    let mut ref_rows = Vec::new();
-    for r in rows {
-        let i = (r.0 * 1e4).round() as usize;
-        let Some(s) = reference.get(i) else { continue };
-        a += (r.1 - s.output_angle_rad).powi(2);
-        w += (r.2 - s.output_speed_rad_s).powi(2);
-        f += (r.3 - s.pressing_force_n).powi(2);
-        tq += (r.4 - s.braking_torque_nm).powi(2);
-        n += 1.0;
-        ref_rows.push((s.t_s, s.output_speed_rad_s));
-    }
-    let n = f64::max(n, 1.0);
-    let mine: Vec<(f64, f64)> = rows.iter().map(|r| (r.0, r.2)).collect();
-    let lock_err_s = match (lock_time(&mine, release), lock_time(&ref_rows, release)) {
-        (Some(x), Some(y)) => (x - y).abs(),
-        _ => 1.0,
-    };
-    // Holding torque: only where the reference ends at rest under the pack (the braking
-    // scenes and hold; a driven output has no holding torque).
-    let hold = rows.last().map_or(0.0, |r| r.4);
-    let held = reference
-        .last()
-        .filter(|s| s.output_speed_rad_s.abs() < STOP_RAD_S)
-        .map(|s| s.braking_torque_nm);
-    Errors {
-        angle_rms: (a / n).sqrt(),
-        speed_rms: (w / n).sqrt(),
-        force_rms_pct: 100.0 * (f / n).sqrt() / f_loaded,
-        torque_rms: (tq / n).sqrt(),
-        lock_err_s,
-        hold_rel: held.map_or(0.0, |t| (hold - t).abs() / t.abs().max(1e-9)),
-    }
-}
-
 /// One row of the speed-accuracy table.
 #[derive(Clone, Debug)]
 struct Variant {
@@ -339,124 +122,6 @@ fn core_costs(core: Core, echo: bool) -> Result<Vec<(String, String, f64, f64)>,
         return Err("noback-bench did not finish".into());
     }
     Ok(v)
-}
-
-/// Stability-map row.
-#[derive(Clone, Debug)]
-struct StabRow {
-    method: &'static str,
-    /// Which parameter is scaled: `k` (contact stiffness), `Jc` (connecting-shaft inertia,
-    /// i.e. the inertia ratio against the output), `mu` (both friction coefficients), or `base`.
-    parameter: &'static str,
-    scale: f64,
-    h_us: f64,
-    verdict: &'static str,
-    diverged_at_s: Option<f64>,
-    speed_rms: Option<f64>,
-    rhs_evals: u64,
-}
-
-/// Threshold of "inaccurate" for the explicit runs: output-speed RMS against the twin (rad/s).
-pub const STAB_INACCURATE_RAD_S: f64 = 0.1;
-
-fn stability(quick: bool) -> Result<Vec<StabRow>, String> {
-    let window = if quick { 0.01 } else { 0.03 };
-    let steps_us: &[f64] = if quick {
-        &[0.125, 0.5, 1.0, 2.0, 2.5, 4.0, 5.0, 10.0]
-    } else {
-        &[0.125, 0.25, 0.5, 1.0, 2.0, 2.5, 4.0, 5.0, 10.0, 20.0]
-    };
-    // What makes the full model stiff or soft: contact stiffness, the light connecting shaft
-    // against the output (inertia ratio), and friction. One factor at a time around Table 2.
-    let variations: &[(&'static str, f64)] = if quick {
-        &[("base", 1.0)]
-    } else {
-        &[
-            ("base", 1.0),
-            ("k", 0.25),
-            ("k", 4.0),
-            ("Jc", 0.25),
-            ("Jc", 4.0),
-            ("mu", 0.5),
-            ("mu", 1.5),
-        ]
-    };
-    let mut rows = Vec::new();
-    for &(parameter, ks) in variations {
-        let mut scene = Scene::builtin(SceneKind::ReverseLoad, Reading::Physical);
-        let m = &mut scene.mechanism;
-        match parameter {
-            "k" => m.contact_stiffness *= ks,
-            "Jc" => m.connecting_inertia_kg_m2 *= ks,
-            "mu" => {
-                m.mu_static *= ks;
-                m.mu_dynamic *= ks;
-            }
-            _ => {}
-        }
-        scene.duration_s = window;
-        scene.tolerance = 1e-8;
-        let reference = run_model(&scene, Physical::new(model_config(&scene)))
-            .map_err(|e| format!("twin reference: {e:?}"))?
-            .samples;
-        for method in [Explicit::Euler, Explicit::Rk4] {
-            for &h in steps_us {
-                let mut model = Physical::new(model_config(&scene));
-                let r = explicit::integrate(&mut model, method, h * 1e-6, window, 1e-4);
-                let (verdict, at, rms) = match r.verdict {
-                    Verdict::Diverged { at_s } => ("diverged", Some(at_s), None),
-                    Verdict::Finished => {
-                        let (mut s, mut n) = (0.0, 0.0);
-                        for (t, _, w) in &r.samples {
-                            if let Some(x) = reference.get((t * 1e4).round() as usize) {
-                                s += (w - x.output_speed_rad_s).powi(2);
-                                n += 1.0;
-                            }
-                        }
-                        let rms = (s / f64::max(n, 1.0)).sqrt();
-                        (
-                            if rms > STAB_INACCURATE_RAD_S {
-                                "inaccurate"
-                            } else {
-                                "stable"
-                            },
-                            None,
-                            Some(rms),
-                        )
-                    }
-                };
-                eprintln!(
-                    "bench: stability {} {parameter}×{ks} h={h} µs: {verdict}",
-                    method.name()
-                );
-                // A converging method's verdict cannot improve with a coarser step: a run under
-                // the threshold whose finer neighbour is over it is error cancellation near the
-                // stability limit, rated inaccurate (its RMS stays in the CSV).
-                let finer_inaccurate = rows.iter().any(|r: &StabRow| {
-                    r.method == method.name()
-                        && r.parameter == parameter
-                        && r.scale == ks
-                        && r.verdict == "inaccurate"
-                });
-                let verdict = if verdict == "stable" && finer_inaccurate {
-                    "inaccurate"
-                } else {
-                    verdict
-                };
-                rows.push(StabRow {
-                    method: method.name(),
-                    parameter,
-                    scale: ks,
-                    h_us: h,
-                    verdict,
-                    diverged_at_s: at,
-                    speed_rms: rms,
-                    rhs_evals: r.rhs_evals,
-                });
-            }
-        }
-    }
-    Ok(rows)
 }
 
 fn opt(v: Option<f64>) -> String {
@@ -669,65 +334,31 @@ pub fn main(args: &[String]) -> Result<i32, String> {
         }
     }
     eprintln!("bench: stability of explicit steps on the full physical model");
-    let stab = stability(quick)?;
+    let stab = stability_map::run(quick)?;
 
-    // Outputs.
-    let dir = workspace_root().join("docs").join("results");
+    // Outputs: the pages under docs/results, or with `--json` a scratch directory under target/.
+    let dir = if json {
+        workspace_root().join("target").join("bench-json")
+    } else {
+        workspace_root().join("docs").join("results")
+    };
     std::fs::create_dir_all(&dir).map_err(|e| e.to_string())?;
-    let mut csv = String::from("family,format,method,rate_hz,scene,angle_rms_rad,speed_rms_rad_s,force_rms_pct,torque_rms_nm,lock_err_s,hold_rel,meets_targets,m3_insns_per_step,m3_insns_per_s,host_ns_per_step,rhs_evals_per_s,torque_rms_physical_nm\n");
-    for v in &variants {
-        let _ = writeln!(
-            csv,
-            "{},{},{},{},{},{:.6e},{:.6e},{:.4},{:.6e},{:.5},{:.5},{},{},{},{:.1},{},{}",
-            v.family,
-            v.format,
-            v.method,
-            v.rate_hz,
-            v.scene,
-            v.e.angle_rms,
-            v.e.speed_rms,
-            v.e.force_rms_pct,
-            v.e.torque_rms,
-            v.e.lock_err_s,
-            v.e.hold_rel,
-            v.e.meets_targets(),
-            opt(v.m3_insns_per_step),
-            opt(v.m3_per_s()),
-            v.host_ns_per_step,
-            v.rhs_evals,
-            opt(v.e_phys.map(|e| e.torque_rms))
-        );
-    }
-    let _ = writeln!(
-        csv,
-        "shipped-monitor,I16F16+Scale+u32 angle,observer,10000,reverse_load,,,,{monitor_paper:.6e},,,,{shipped_insns:.1},{:.6e},,,{monitor_phys:.6e}",
-        shipped_insns * 1e4
-    );
+    let rows: Vec<_> = variants
+        .iter()
+        .map(|v| host_speed::Row {
+            family: &v.family,
+            format: &v.format,
+            method: &v.method,
+            scene: v.scene,
+            ns_per_step: v.host_ns_per_step,
+        })
+        .collect();
+    std::fs::write(dir.join("host-speed.md"), host_speed::page(&rows, quick))
+        .map_err(|e| e.to_string())?;
+    let csv = pages::speed_accuracy_csv(&variants, shipped_insns, monitor_paper, monitor_phys);
     std::fs::write(dir.join("speed-accuracy.csv"), &csv).map_err(|e| e.to_string())?;
 
-    let mut scsv = String::from(
-        "method,parameter,scale,step_us,verdict,diverged_at_s,speed_rms_rad_s,rhs_evals\n",
-    );
-    for r in &stab {
-        let _ = writeln!(
-            scsv,
-            "{},{},{},{},{},{},{},{}",
-            r.method,
-            r.parameter,
-            r.scale,
-            r.h_us,
-            r.verdict,
-            opt(r.diverged_at_s),
-            opt(r.speed_rms),
-            r.rhs_evals
-        );
-    }
-    std::fs::write(dir.join("stability.csv"), &scsv).map_err(|e| e.to_string())?;
-    let lanes: Vec<charts::StabCell> = stab
-        .iter()
-        .map(|r| (r.method, r.parameter, r.scale, r.h_us, r.verdict))
-        .collect();
-    charts::stability(&dir.join("stability.svg"), &lanes)?;
+    stability_map::write(&dir, &stab)?;
 
     // Chart and Pareto fronts: reduced variants on reverse_load, braking-torque RMS (the
     // quantity the monitor estimates) against each reading, with the shipped monitor's point.
@@ -766,78 +397,15 @@ pub fn main(args: &[String]) -> Result<i32, String> {
     )?;
 
     // Cheapest per scene.
-    let mut md = String::from("# The cheapest model per scene\n\nWritten by `cargo xtask bench`. Cheapest = fewest Cortex-M3 instructions per simulated second among the candidates that meet the monitor's accuracy targets against the twin's `paper` reading at tolerance 1e-10: output-speed RMS ≤ 0.5 rad/s, pressing-force RMS ≤ 5 % of the loaded force, lock time within 10 ms, holding torque within 5 % (targets from docs/monitor-design.md). Candidates: every format × integrator × rate of the reduced model, and the quasi-static model with no state to advance (output at the drive's speed while driven, at rest once the drive is cut; 0 instructions of model step). The monitor runs, per scene it recognises, the model named here (`Monitor::scene_model`); `host-tests/tests/monitor_scene_models.rs` fails when they differ.\n\n| scene | cheapest variant | M3 insns/step | M3 insns/s | angle RMS (rad) | speed RMS (rad/s) | force RMS % | lock error (ms) |\n|---|---|---|---|---|---|---|---|\n");
-    let mut cheapest_rows = Vec::new();
-    for (name, _, _) in scenes.iter().chain(still_scenes.iter()) {
-        let name = *name;
-        let best = variants
-            .iter()
-            .filter(|v| {
-                v.family != "shipped" && v.rate_hz > 0.0 && v.scene == name && v.e.meets_targets()
-            })
-            .min_by(|a, b| {
-                a.m3_per_s()
-                    .unwrap_or(f64::MAX)
-                    .total_cmp(&b.m3_per_s().unwrap_or(f64::MAX))
-            });
-        match best {
-            Some(v) => {
-                let _ = writeln!(
-                    md,
-                    "| {name} | {} | {:.0} | {:.3e} | {:.2e} | {:.3} | {:.3} | {:.1} |",
-                    v.label(),
-                    v.m3_insns_per_step.unwrap_or(f64::NAN),
-                    v.m3_per_s().unwrap_or(f64::NAN),
-                    v.e.angle_rms,
-                    v.e.speed_rms,
-                    v.e.force_rms_pct,
-                    v.e.lock_err_s * 1e3
-                );
-                cheapest_rows.push((name, v.label()));
-            }
-            None => {
-                let _ = writeln!(md, "| {name} | none meets the targets | | | | | | |");
-            }
-        }
-    }
-    // Continuous closing: the reduced model has no drive-on engagement cycle (the paper
-    // reading's 0.444 s limit cycle); the monitor's overrunning equilibrium is the only
-    // candidate, measured through the monitor against the physical reading (its ground truth).
-    let closing = crate::replay::twin_trace("continuous_closing")?;
-    let closing_acc = host_tests::accuracy::compare(
-        &closing,
-        &host_tests::accuracy::run_monitor(&closing, noback::monitor::Config::default())?,
-    );
-    let _ = writeln!(
-        md,
-        "| continuous_closing | {EQUILIBRIUM_LABEL} | 0 | 0 | | | {:.3} | |",
-        closing_acc.pressing_force_rmse_pct
-    );
-    cheapest_rows.push(("continuous_closing", EQUILIBRIUM_LABEL.to_string()));
-    md.push_str("\nContinuous closing: the reduced model has no drive-on engagement cycle, so the only candidate is the monitor's overrunning equilibrium (`T = g₁·v − g₀` from the drive torque, no state); its force RMS above is the whole monitor against the twin's `physical` reading (% of the peak, the monitor's 10 % target, `cargo xtask monitor continuous_closing`).\n");
-    let _ = writeln!(
-        md,
-        "\nThe shipped monitor (whole estimator: observer, model, flags) costs {shipped_insns:.1} M3 instructions per 10 kHz tick, its interrupt's part and its background call together ({:.3e} per simulated second).",
-        shipped_insns * 1e4
-    );
+    let names: Vec<&str> = scenes
+        .iter()
+        .chain(still_scenes.iter())
+        .map(|s| s.0)
+        .collect();
+    let (md, cheapest_rows) = pages::cheapest(&variants, &names, shipped_insns)?;
     std::fs::write(dir.join("cheapest-per-scene.md"), &md).map_err(|e| e.to_string())?;
 
-    // Cost by core: the format that is cheap on an M3 (single-cycle 32×32→64 multiply) is not
-    // necessarily cheap on an M0 (no long multiply, no FPU).
-    let mut cores_md = String::from(
-        "# Instructions per step by core\n\nWritten by `cargo xtask bench`; do not edit. \
-         `noback-bench` under QEMU `-icount` (reverse-load braking, 3000 steps each).\n\n\
-         | format | integrator | M3 mean | M3 max | M0 mean | M0 max | M0 / M3 |\n|---|---|---|---|---|---|---|\n",
-    );
-    for (f, m, mean3, max3) in &m3 {
-        if let Some((_, _, mean0, max0)) = m0.iter().find(|(a, b, _, _)| a == f && b == m) {
-            let _ = writeln!(
-                cores_md,
-                "| {f} | {m} | {mean3:.0} | {max3:.0} | {mean0:.0} | {max0:.0} | {:.1} |",
-                mean0 / mean3.max(1.0)
-            );
-        }
-    }
+    let cores_md = pages::cost_by_core(&m3, &m0);
     std::fs::write(dir.join("cost-by-core.md"), &cores_md).map_err(|e| e.to_string())?;
 
     if json {
@@ -913,7 +481,7 @@ pub fn main(args: &[String]) -> Result<i32, String> {
         }
         println!("shipped monitor: {shipped_insns:.1} M3 insns/step");
         println!(
-            "\nwrote docs/results/speed-accuracy.{{csv,svg}}, stability.{{csv,svg}}, cheapest-per-scene.md, cost-by-core.md in {:.0} s",
+            "\nwrote docs/results/speed-accuracy.{{csv,svg}}, stability.{{csv,svg}}, cheapest-per-scene.md, cost-by-core.md, host-speed.md in {:.0} s",
             t0.elapsed().as_secs_f64()
         );
     }

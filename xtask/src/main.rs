@@ -15,6 +15,7 @@ mod defmt_log;
 mod elf_size;
 mod fuzz;
 mod golden;
+mod machine;
 mod monitor;
 mod monitor_mc;
 mod opt_level;

@@ -115,20 +115,11 @@ pub fn main(args: &[String]) -> Result<i32, String> {
     }
     let wp_md = wp::markdown(&pts);
     print!("{wp_md}");
-    let cpu = std::fs::read_to_string("/proc/cpuinfo")
-        .ok()
-        .and_then(|c| {
-            c.lines()
-                .find(|l| l.starts_with("model name"))
-                .and_then(|l| l.split(':').nth(1))
-                .map(|m| m.trim().to_string())
-        })
-        .unwrap_or_else(|| std::env::consts::ARCH.to_string());
-    let cores = std::thread::available_parallelism().map_or(1, |n| n.get());
+    let machine = crate::machine::this();
     let doc = format!(
         "# Twin speed against diffsol and scipy Radau (benchmark page)\n\nWritten by `cargo xtask twin-bench{}`; do not edit. \
          Release build, physical reading, same equations and tolerance on both sides. Wall times \
-         from one run on {cpu} ({cores} cores, shared): a benchmark, not a test, and they change \
+         from one run on {machine} (shared): a benchmark, not a test, and they change \
          from run to run. Errors are against the converged references \
          (`twin/tests/reference/converged.json`, tolerance 1e-10; braking time and angle, the \
          metrics both sides report); a speed ratio is given only where both sides hold them within 1 % (continuous closing has \

@@ -15,18 +15,6 @@ pub struct ThroughputArgs {
     runs: u64,
 }
 
-fn first_line_with(path: &str, key: &str) -> String {
-    std::fs::read_to_string(path)
-        .ok()
-        .and_then(|t| {
-            t.lines()
-                .find(|l| l.starts_with(key))
-                .and_then(|l| l.split(':').nth(1))
-                .map(|v| v.trim().to_string())
-        })
-        .unwrap_or_else(|| "unknown".into())
-}
-
 /// CPU seconds this process has used, all threads (`/proc/self/stat` utime + stime, at the
 /// kernel's USER_HZ of 100).
 fn cpu_s() -> f64 {
@@ -51,10 +39,8 @@ fn rate(draws: &[host_tests::mc::Draw], threads: usize) -> (f64, f64) {
 
 /// Entry.
 pub fn main(a: &ThroughputArgs) -> Result<(), String> {
-    let cores = std::thread::available_parallelism().map_or(1, |n| n.get());
-    let load = std::fs::read_to_string("/proc/loadavg").unwrap_or_default();
-    let load = load.split_whitespace().next().unwrap_or("?").to_string();
-    let cpu = first_line_with("/proc/cpuinfo", "model name");
+    let machine = crate::machine::this();
+    let cores = machine.cores;
     let nominal: Vec<_> = (0..a.runs).map(|i| draw(1, i, None)).collect();
     let faults: Vec<_> = FAULT_KINDS
         .iter()
@@ -73,9 +59,8 @@ pub fn main(a: &ThroughputArgs) -> Result<(), String> {
         s,
         "# Monte Carlo throughput (benchmark: machine-dependent)\n\n\
          Written by `cargo xtask monitor-mc throughput --runs {}`; timings differ from run to run \
-         and machine to machine, unlike `monitor.md`. Machine: {cpu}, {cores} cores as the OS \
-         reports them, load average {load} when it started (shared: wall-clock rates fall with \
-         the load, rates per CPU second much less).\n\n\
+         and machine to machine, unlike `monitor.md`. Machine: {machine} (shared: wall-clock rates \
+         fall with the load, rates per CPU second much less).\n\n\
          | what | runs per wall-clock second | runs per CPU second |\n|---|---|---|\n\
          | nominal runs, 1 thread | {one:.1} | {one_cpu:.1} |\n\
          | fault runs, 1 thread | {fault:.1} | {fault_cpu:.1} |\n\
