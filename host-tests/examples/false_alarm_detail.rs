@@ -31,11 +31,14 @@ const CHECKS: [(&str, SwitchOff); 7] = [
 /// Samples shown before the first flag and the stride: 20 ms every 1 ms, or `DETAIL_MS`
 /// milliseconds in about 40 lines.
 fn window() -> (usize, usize) {
-    let ms: usize = std::env::var("DETAIL_MS")
-        .ok()
-        .and_then(|v| v.parse().ok())
-        .unwrap_or(20);
-    (ms * 10, (ms * 10 / 40).max(10))
+    let ms: usize = match std::env::var("DETAIL_MS") {
+        Err(_) => 20,
+        Ok(v) => v.parse().unwrap_or_else(|e| {
+            eprintln!("error: DETAIL_MS '{v}' is not a whole number of milliseconds ({e})");
+            std::process::exit(2)
+        }),
+    };
+    (ms.saturating_mul(10), (ms.saturating_mul(10) / 40).max(10))
 }
 
 fn main() -> Result<(), String> {
@@ -52,6 +55,7 @@ fn main() -> Result<(), String> {
         eprintln!("error: usage: false_alarm_detail SEED RUN [RUN …]");
         std::process::exit(2)
     };
+    let (span, every) = window();
     for &i in runs {
         let d = draw_in(Family::Plant, seed, i, None);
         let s = &d.scene;
@@ -89,7 +93,6 @@ fn main() -> Result<(), String> {
             }
         }
         let at = (first.t_s * trace.sample_rate_hz).round() as usize;
-        let (span, every) = window();
         for k in (at.saturating_sub(span)..=at.min(est.len().saturating_sub(1))).step_by(every) {
             let (e, r) = (&est[k], &trace.rows[k]);
             println!(
