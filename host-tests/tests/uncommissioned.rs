@@ -31,17 +31,41 @@ fn family_draw(seed: u64, run: u64) -> (Draw, Trace) {
     (d, trace)
 }
 
-/// What the family's uncommissioned monitor makes of a draw's trace.
-fn family_monitor(trace: &Trace) -> Accuracy {
-    compare(
-        trace,
-        &run_monitor(trace, Family::Plant.config()).expect("monitor"),
-    )
+/// What the monitor set with `config` makes of a trace.
+fn monitor(trace: &Trace, config: Config) -> Accuracy {
+    compare(trace, &run_monitor(trace, config).expect("monitor"))
+}
+
+/// How far the output came back (rad) from the point farthest from where the drive was cut.
+fn turned_back(trace: &Trace) -> f64 {
+    let cut = trace
+        .rows
+        .iter()
+        .rposition(|r| r.drive_on)
+        .expect("a drive");
+    let from = trace.rows[cut].output_angle_rad;
+    let farthest = trace.rows[cut..]
+        .iter()
+        .map(|r| r.output_angle_rad)
+        .fold(from, |a, b| {
+            if (b - from).abs() > (a - from).abs() {
+                b
+            } else {
+                a
+            }
+        });
+    (farthest - trace.rows.last().expect("rows").output_angle_rad).abs()
+}
+
+/// Asserts that the family's uncommissioned monitor raises nothing on `trace`.
+fn assert_quiet(trace: &Trace) {
+    let acc = monitor(trace, Family::Plant.config());
+    assert!(acc.flags.is_empty(), "{:?}", acc.flag_times());
 }
 
 /// Asserts that the monitor set with `config` raises `flag` on `trace`.
 fn assert_raises(trace: &Trace, config: Config, flag: &str) {
-    let acc = compare(trace, &run_monitor(trace, config).expect("monitor"));
+    let acc = monitor(trace, config);
     assert!(
         acc.flags.iter().any(|f| f.flag == flag),
         "{:?}",
@@ -58,10 +82,7 @@ fn healthy_scenes_of_both_readings_raise_nothing_uncommissioned() {
                 let mut scene = Scene::builtin(kind, reading);
                 scene.load_torque_nm = load;
                 let trace = scene_trace(&scene).expect("twin");
-                let acc = compare(
-                    &trace,
-                    &run_monitor(&trace, Config::default()).expect("monitor"),
-                );
+                let acc = monitor(&trace, Config::default());
                 if not_driven(&trace, &scene.sensors) {
                     not_moving += 1;
                     assert!(
@@ -112,23 +133,12 @@ fn the_physical_readings_settings_tighten_only_the_family_wide_limits() {
 #[test]
 fn a_load_turning_the_output_back_until_the_ramps_clamp_is_no_slip() {
     let (_, trace) = family_draw(1616, 2875);
-    let start = trace
-        .rows
-        .iter()
-        .rposition(|r| r.drive_on)
-        .expect("a drive");
-    let stop = trace.rows[start..]
-        .iter()
-        .map(|r| r.output_angle_rad)
-        .fold(f64::NEG_INFINITY, |a, b| a.max(-b));
-    let end = -trace.rows.last().expect("rows").output_angle_rad;
+    let back = turned_back(&trace);
     assert!(
-        stop - end > 0.15,
-        "turned back {:.3} rad, more than the creep limit",
-        stop - end
+        back > 0.15,
+        "turned back {back:.3} rad, more than the creep limit"
     );
-    let acc = family_monitor(&trace);
-    assert!(acc.flags.is_empty(), "{:?}", acc.flag_times());
+    assert_quiet(&trace);
 }
 
 /// Tuning seed 1616's run 791 (paper form, forward load 5.7 N·m, sliding at μ_d): after the cut
@@ -146,8 +156,7 @@ fn a_pack_braking_at_a_third_of_the_model_is_not_weak_uncommissioned() {
         .map(|r| (r.output_angle_rad - from).abs())
         .fold(0.0, f64::max);
     assert!(travel > 3.0, "braked within {travel:.2} rad");
-    let acc = family_monitor(&trace);
-    assert!(acc.flags.is_empty(), "{:?}", acc.flag_times());
+    assert_quiet(&trace);
     // With the physical reading's factor (2×) and nothing else changed, it is called weak.
     let tight = Config {
         thresholds: Thresholds {
@@ -180,8 +189,7 @@ fn an_input_that_comes_apart_from_its_output_is_counted_apart_and_flagged() {
 #[test]
 fn continuous_closings_chatter_at_a_light_load_and_a_soft_servo_is_no_drag() {
     let (_, trace) = family_draw(4242, 3716);
-    let acc = family_monitor(&trace);
-    assert!(acc.flags.is_empty(), "{:?}", acc.flag_times());
+    assert_quiet(&trace);
 }
 
 /// Tuning seed 7's run 9297 (physical form, reverse load): at power-on a seated contact sat at
@@ -208,8 +216,7 @@ fn a_braking_slower_in_time_as_in_angle_is_not_weak_uncommissioned() {
         speed > 1.0,
         "turning at {speed:.2} rad/s 0.66 s after the cut"
     );
-    let acc = family_monitor(&trace);
-    assert!(acc.flags.is_empty(), "{:?}", acc.flag_times());
+    assert_quiet(&trace);
 }
 
 /// Tuning seed 4242's run 76699 (physical form, forward load 17.9 N·m): the drive's chatter
@@ -220,7 +227,7 @@ fn a_braking_slower_in_time_as_in_angle_is_not_weak_uncommissioned() {
 fn an_output_accelerating_in_the_chatter_at_the_cut_is_braked_not_undecelerated() {
     let (d, trace) = family_draw(4242, 76699);
     assert!(d.scene.faults.is_empty());
-    assert!(family_monitor(&trace).flags.is_empty());
+    assert_quiet(&trace);
     let mut tight = Family::Plant.config();
     tight.thresholds.undecelerated_allowance_rad = 0.01;
     assert_raises(&trace, tight, "brake_weak");
@@ -234,8 +241,7 @@ fn an_output_accelerating_in_the_chatter_at_the_cut_is_braked_not_undecelerated(
 fn the_servos_settling_after_a_power_on_guess_is_no_lost_gain() {
     let (d, trace) = family_draw(4242, 13514);
     assert!(d.scene.faults.is_empty());
-    let acc = family_monitor(&trace);
-    assert!(acc.flags.is_empty(), "{:?}", acc.flag_times());
+    assert_quiet(&trace);
 }
 
 /// Tuning seed 4242's run 26510 (paper form, reverse load 24.8 N·m): after the door stops the
@@ -246,15 +252,8 @@ fn the_servos_settling_after_a_power_on_guess_is_no_lost_gain() {
 fn a_turn_back_the_pack_keeps_slowing_is_no_slip() {
     let (d, trace) = family_draw(4242, 26510);
     assert!(d.scene.faults.is_empty());
-    let cut = d.scene.release_at_s.expect("a cut");
-    let after: Vec<_> = trace.rows.iter().filter(|r| r.t_s > cut).collect();
-    let stop = after
-        .windows(2)
-        .position(|w| w[0].output_speed_rad_s * w[1].output_speed_rad_s <= 0.0)
-        .expect("the door stops");
-    let angles = after[stop..].iter().map(|r| r.output_angle_rad);
-    let span = angles.clone().fold(f64::MIN, f64::max) - angles.fold(f64::MAX, f64::min);
+    let back = turned_back(&trace);
     let limit = Family::Plant.config().thresholds.creep_limit_rad;
-    assert!(span > 2.0 * limit, "turned back {span} rad");
-    assert!(family_monitor(&trace).flags.is_empty());
+    assert!(back > 2.0 * limit, "turned back {back:.3} rad");
+    assert_quiet(&trace);
 }
