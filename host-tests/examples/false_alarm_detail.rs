@@ -24,7 +24,10 @@ const CHECKS: [(&str, SwitchOff); 7] = [
     }),
     ("capacity margin", |t| t.min_capacity_margin = 0.1),
     ("creep", |t| t.creep_limit_rad = 100.0),
-    ("stuck counter", |t| t.max_lost_motion_rad = 100.0),
+    ("stuck counter", |t| {
+        t.max_lost_motion_rad = 100.0;
+        t.free_input_travel_rad = 100.0;
+    }),
     ("dead current", |t| t.dead_current_nm = 1e-3),
 ];
 

@@ -10,6 +10,7 @@
 use host_tests::accuracy::run_monitor;
 use host_tests::family::{form, runs_and_seed, Family};
 use host_tests::mc::{draw_in, draw_trace};
+use host_tests::stats::quantile_line;
 use noback::mechanism::Mechanism;
 use noback::monitor::Config;
 use noback_twin::fault::FaultKind;
@@ -18,19 +19,6 @@ use noback_twin::fault::FaultKind;
 fn service(c: &Config, m: &Mechanism, mu: f64) -> f64 {
     let l = c.thresholds.max_load_nm;
     m.pack_capacity_nm(m.quasi_static_pressing_force_n(l), mu) / l
-}
-
-fn quantiles(mut r: Vec<f64>) -> String {
-    r.sort_by(f64::total_cmp);
-    let q = |p: f64| r[((r.len() - 1) as f64 * p).round() as usize];
-    format!(
-        "min {:.3}, 1 % {:.3}, 2.5 % {:.3}, median {:.3}, max {:.3}",
-        r[0],
-        q(0.01),
-        q(0.025),
-        q(0.5),
-        r[r.len() - 1]
-    )
 }
 
 fn main() -> Result<(), String> {
@@ -50,7 +38,7 @@ fn main() -> Result<(), String> {
         println!(
             "family {}, seed {seed}, {runs} draws: model margin {model:.3}; drawn over model: {}",
             family.name(),
-            quantiles(r)
+            quantile_line(r, &[0.01, 0.025, 0.5])
         );
         return Ok(());
     }
@@ -91,7 +79,7 @@ fn main() -> Result<(), String> {
                 "{:13} {f:8}: lower bound held in {held} of {} runs; margin over the truth: {}",
                 fault.map_or("healthy".into(), |k| format!("{k:?}")),
                 here.len(),
-                quantiles(here.iter().map(|s| s.1).collect())
+                quantile_line(here.iter().map(|s| s.1).collect(), &[0.01, 0.025, 0.5])
             );
         }
     }

@@ -1,7 +1,7 @@
 //! Confidence bounds on the Monte Carlo's rates: the Clopper–Pearson ("exact") interval of a
 //! binomial proportion, the Beta distribution's quantiles found by bisection on its CDF
-//! (`statrs`; its own inverse CDF hangs at Beta(1, 10⁷)), and the campaign size an interval of a
-//! given width needs.
+//! (`statrs`; its own inverse CDF hangs at Beta(1, 10⁷)), the campaign size an interval of a
+//! given width needs, and a sample's nearest-rank quantiles as the examples print them.
 
 use statrs::distribution::{Beta, ContinuousCDF};
 
@@ -87,9 +87,39 @@ pub fn trials_for_zero_events_below(bound: f64) -> u64 {
     n
 }
 
+/// `values`' minimum, nearest-rank quantiles at `at` (shares in (0, 1); 0.5 is the median) and
+/// maximum on one line: "min 0.786, 1 % 0.790, median 1.000, max 1.210"; "none" when empty.
+pub fn quantile_line(mut values: Vec<f64>, at: &[f64]) -> String {
+    values.sort_by(f64::total_cmp);
+    let (Some(first), Some(last)) = (values.first(), values.last()) else {
+        return "none".into();
+    };
+    let rank = |p: f64| values[((values.len() - 1) as f64 * p).round() as usize];
+    let mut line = format!("min {first:.3}");
+    for &p in at {
+        let name = if p == 0.5 {
+            "median".into()
+        } else {
+            format!("{} %", p * 100.0)
+        };
+        line += &format!(", {name} {:.3}", rank(p));
+    }
+    line + &format!(", max {last:.3}")
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn quantile_line_names_each_rank() {
+        let v: Vec<f64> = (0..=100).map(f64::from).collect();
+        assert_eq!(
+            quantile_line(v, &[0.025, 0.5]),
+            "min 0.000, 2.5 % 3.000, median 50.000, max 100.000"
+        );
+        assert_eq!(quantile_line(Vec::new(), &[0.5]), "none");
+    }
 
     #[test]
     fn bounds_match_closed_forms_and_a_published_value() {

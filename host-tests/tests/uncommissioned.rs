@@ -8,10 +8,11 @@
 //! (docs/decisions.md). A plant whose input comes apart from its output (the paper
 //! reading's closing at loads up to 8 N·m) is not healthy: the monitor must flag it.
 
-use host_tests::accuracy::{compare, run_monitor, scene_trace, Accuracy};
+use host_tests::accuracy::{compare, detection_latency_s, run_monitor, scene_trace, Accuracy};
 use host_tests::family::Family;
 use host_tests::mc::{draw_in, draw_trace, not_driven, Draw};
 use noback::monitor::{Config, Thresholds};
+use noback_twin::fault::FaultKind;
 use noback_twin::reading::Reading;
 use noback_twin::scene::{Scene, SceneKind};
 use noback_twin::trace::Trace;
@@ -109,11 +110,13 @@ fn the_physical_readings_settings_tighten_only_the_family_wide_limits() {
     assert!(u.dead_current_nm < p.dead_current_nm);
     assert!(u.braking_angle_allowance_rad > p.braking_angle_allowance_rad);
     assert!(u.braking_angle_factor > p.braking_angle_factor);
+    assert!(u.driven_torque_nm > p.driven_torque_nm);
     let same = Thresholds {
         opposed_braking_share: p.opposed_braking_share,
         dead_current_nm: p.dead_current_nm,
         braking_angle_allowance_rad: p.braking_angle_allowance_rad,
         braking_angle_factor: p.braking_angle_factor,
+        driven_torque_nm: p.driven_torque_nm,
         ..u
     };
     assert_eq!(same, p, "every other threshold is shared");
@@ -256,4 +259,34 @@ fn a_turn_back_the_pack_keeps_slowing_is_no_slip() {
     let limit = Family::Plant.config().thresholds.creep_limit_rad;
     assert!(back > 2.0 * limit, "turned back {back:.3} rad");
     assert_quiet(&trace);
+}
+
+/// Tuning seed 4242's runs 42355 and 66709 (paper form, continuous closing at 8.1 and 8.9 N·m):
+/// the pack holds the door while the ideal speed input turns on at 12.9 rad/s with 0.4 N·m of
+/// drive torque (the sensor's offset). Not counted apart (its output counter ticks now and
+/// then); on the build before, `sensor_fault` from the stuck counter at 0.2 rad.
+#[test]
+fn an_input_turning_free_of_a_held_output_is_given_the_free_span() {
+    for run in [42355, 66709] {
+        let (d, trace) = family_draw(4242, run);
+        assert!(d.scene.faults.is_empty() && !not_driven(&trace, &d.scene.sensors));
+        assert_quiet(&trace);
+        let mut tight = Family::Plant.config();
+        tight.thresholds.driven_torque_nm = 0.0;
+        assert_raises(&trace, tight, "sensor_fault");
+    }
+}
+
+/// Tuning seed 1616's encoder_stuck run 22 (paper form, continuous closing at 25.2 N·m): the
+/// output encoder freezes while the ideal speed input drives the door with no drive torque,
+/// which the sensors cannot tell from an input turning free: called at the free span, the
+/// slowest of that seed's such runs, 37.5 ms after manifesting (20.3 ms at 0.2 rad).
+#[test]
+fn a_stuck_output_encoder_with_no_drive_torque_is_called_at_the_free_span() {
+    let d = draw_in(Family::Plant, 1616, 22, Some(FaultKind::EncoderStuck));
+    let trace = draw_trace(&d).expect("twin");
+    let fault = d.scene.faults.first().expect("a fault");
+    let acc = monitor(&trace, Family::Plant.config());
+    let latency = detection_latency_s(fault, &trace, &acc).expect("detected");
+    assert!(latency <= 0.05, "{latency} s after manifesting");
 }

@@ -141,6 +141,13 @@ pub struct Thresholds {
     /// Travel of one shaft while the other's counter stands still, driving, before the still
     /// counter counts as stuck (rad, output side).
     pub max_lost_motion_rad: f64,
+    /// The same span while the drive carries no torque (mean |drive torque| over the still
+    /// span below `driven_torque_nm`): an input turning free of its output, as the paper
+    /// reading's ideal speed input does along a load its pack holds (rad, output side).
+    pub free_input_travel_rad: f64,
+    /// Mean |drive torque| (N·m) over the still span at or above which the drive carries a
+    /// load; 0: the input never counts as turning free.
+    pub driven_torque_nm: f64,
     /// Largest plausible |current| with the drive off (A).
     pub current_off_max_a: f64,
     /// Time at an ADC rail before the current reading counts as failed (s).
@@ -209,7 +216,9 @@ impl Thresholds {
         input_speed_filter_hz: 200.0,
         max_output_speed_rad_s: 60.0,
         max_motor_speed_rad_s: 1800.0,
-        max_lost_motion_rad: 0.2, // the twin's lost motion is 0.03–0.1 rad
+        max_lost_motion_rad: 0.2,   // the twin's lost motion is 0.03–0.1 rad
+        free_input_travel_rad: 0.3, // where the Monte Carlo counts an input apart
+        driven_torque_nm: 1.0,      // turning free ≤ 0.41 N·m (offset); driven ≥ 2.0 N·m
         current_off_max_a: 3.0,
         adc_rail_time_s: 0.01, // overrunning chatter stalls the motor at the current limit ≈ 3 ms
         dead_current_nm: 0.0,  // off: the paper reading closes on almost no drive torque
@@ -230,6 +239,7 @@ impl Thresholds {
         braking_angle_allowance_rad: 0.1, // the twin's healthy pack stops within 0.07 rad
         opposed_braking_share: 1.0,       // both socket faces clamp from the cut
         dead_current_nm: 0.5,             // healthy ≥ 1.42 N·m; a dead reading's noise ≈ 0.13 N·m
+        driven_torque_nm: 0.0,            // a drive face: the input never turns free
         ..Thresholds::DEFAULT
     };
 }

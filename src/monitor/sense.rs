@@ -9,6 +9,7 @@
 //! | angle word | `u32`, wrapping | one turn | 2π/2³² rad |
 //! | input speed | [`Q16`] rad/s, saturating | ±32 768 | 1.5e-5 rad/s |
 //! | position history | `i16` counts mod 2^16, wrapping | differences over ≤ 63 ticks | 1 count |
+//! | still span's \|current\| sum | `u32` counts, saturating (reads free after ≥ 13 s at full scale) | 2^32 | 1 count |
 
 use super::config::{Config, ConfigError};
 use super::convert::{
@@ -45,6 +46,10 @@ pub(crate) struct SenseSettings {
     motor_jump_counts: i32,
     lost_motor_counts: u32,
     lost_out_counts: u32,
+    /// The motor's span against a still output while the drive carries no torque.
+    free_motor_counts: u32,
+    /// Mean |current| (counts) over the still span at or above which the drive carries a load.
+    driven_counts: u32,
     /// Motor counts over one slow-lane period → Q16 rad/s of the input shaft.
     input_speed: Scale<11>,
     input_alpha: Gain,
@@ -112,6 +117,12 @@ impl SenseSettings {
             "current_offset_a",
         )?;
         let lost = positive(t.max_lost_motion_rad, "thresholds.max_lost_motion_rad")?;
+        let free = positive(t.free_input_travel_rad, "thresholds.free_input_travel_rad")?;
+        require(free >= lost, "thresholds.free_input_travel_rad")?;
+        let driven = finite(t.driven_torque_nm, "thresholds.driven_torque_nm")?;
+        require(driven >= 0.0, "thresholds.driven_torque_nm")?;
+        let driven = s.current_for_torque_a(driven) / s.amps_per_count();
+        require(driven < 1.0e5, "thresholds.driven_torque_nm")?;
         let impact_m = positive(t.impact_window_s, "thresholds.impact_window_s")? * tick_hz + 0.5;
         require(
             (1.0..32.0).contains(&impact_m),
@@ -135,6 +146,8 @@ impl SenseSettings {
             motor_jump_counts: counts(motor_jump, "thresholds.max_motor_speed_rad_s")?,
             lost_motor_counts: counts(lost / in_rad, "thresholds.max_lost_motion_rad")? as u32,
             lost_out_counts: counts(lost / out_rad, "thresholds.max_lost_motion_rad")? as u32,
+            free_motor_counts: counts(free / in_rad, "thresholds.free_input_travel_rad")? as u32,
+            driven_counts: rounded(driven) as u32, // 0 ≤ driven < 1e5 (checked above)
             input_speed: scale(
                 in_rad / slow_h * Q16_ONE,
                 "sensors.motor_encoder_counts_per_rev",
@@ -219,6 +232,9 @@ pub(crate) struct Sense {
     /// and of the output while the motor's does.
     still_out: i32,
     still_motor: i32,
+    /// |current| summed (counts, saturating) and calls counted over the output's still span.
+    still_current: u32,
+    still_calls: u32,
     input_speed: Q16,
     /// The motor counter at the last input-speed sample.
     speed_motor: u32,
@@ -239,6 +255,8 @@ impl Sense {
             rail_ticks: 0,
             still_out: 0,
             still_motor: 0,
+            still_current: 0,
+            still_calls: 0,
             input_speed: Q16::ZERO,
             speed_motor: 0,
             positions: [0; POSITION_HISTORY],
@@ -297,11 +315,15 @@ impl Sense {
         } else {
             self.position_ticks = 0;
         }
-        let stuck =
-            carrying && drive && out_ok && motor_ok && self.stuck_counter(k, d_out, d_motor);
+        let stuck = carrying
+            && drive
+            && out_ok
+            && motor_ok
+            && self.stuck_counter(k, d_out, d_motor, current);
         if !(carrying && drive && out_ok && motor_ok) {
             self.still_out = 0;
             self.still_motor = 0;
+            (self.still_current, self.still_calls) = (0, 0);
         }
         let drive_edge = drive != self.prev_drive;
         self.prev_drive = drive;
@@ -342,19 +364,26 @@ impl Sense {
     }
 
     /// Stuck counter: while driving, one shaft's net travel passes the lost-motion limit while
-    /// the other's counter stands still (net, not path: a servo dithering at rest goes nowhere).
-    fn stuck_counter(&mut self, k: &SenseSettings, d_out: i32, d_motor: i32) -> bool {
-        self.still_out = if d_out == 0 {
-            self.still_out.saturating_add(d_motor)
+    /// the other's counter stands still (net, not path: a servo dithering at rest goes nowhere);
+    /// a motor turning against a still output with no drive torque has the free span.
+    fn stuck_counter(&mut self, k: &SenseSettings, d_out: i32, d_motor: i32, current: i32) -> bool {
+        if d_out == 0 {
+            self.still_out = self.still_out.saturating_add(d_motor);
+            self.still_current = self.still_current.saturating_add(current.unsigned_abs());
+            self.still_calls = self.still_calls.saturating_add(1);
         } else {
-            0
-        };
+            self.still_out = 0;
+            (self.still_current, self.still_calls) = (0, 0);
+        }
         self.still_motor = if d_motor == 0 {
             self.still_motor.saturating_add(d_out)
         } else {
             0
         };
-        self.still_out.unsigned_abs() > k.lost_motor_counts
+        let far = self.still_out.unsigned_abs();
+        (far > k.lost_motor_counts
+            && (far > k.free_motor_counts
+                || self.still_current >= self.still_calls.saturating_mul(k.driven_counts)))
             || self.still_motor.unsigned_abs() > k.lost_out_counts
     }
 
@@ -425,32 +454,57 @@ fn rounded(x: f64) -> i32 {
 mod tests {
     use super::*;
 
-    /// The motor moving `steps` (counts per tick) while the output counter stands still.
-    fn stuck_after(steps: impl Iterator<Item = i32>) -> bool {
+    /// The motor moving `steps` (counts per tick) while the output counter stands still, the
+    /// current reading `code`.
+    fn stuck_after(code: u16, steps: impl Iterator<Item = i32>) -> bool {
         let k = SenseSettings::new(&Config::default()).expect("default configuration");
         let (mut sense, mut motor) = (Sense::new(), 0_u32);
         let mut stuck = false;
         for d in steps {
             motor = motor.wrapping_add_signed(d) & k.motor_mask;
-            let x = sense.read(&k, &Inputs::new(2100, motor, 100, true), 1, true);
+            let x = sense.read(&k, &Inputs::new(code, motor, 100, true), 1, true);
             stuck |= x.fault;
         }
         stuck
     }
 
+    /// A reading whose current carries `ratio` × the driven floor.
+    fn driven_code(k: &SenseSettings, ratio: f64) -> u16 {
+        (f64::from(k.adc_mid) + ratio * f64::from(k.driven_counts)) as u16
+    }
+
     #[test]
     fn the_stuck_counter_counts_net_travel_not_a_dithering_path() {
         let k = SenseSettings::new(&Config::default()).expect("default configuration");
-        let limit = k.lost_motor_counts as i32;
+        let (limit, code) = (k.lost_motor_counts as i32, driven_code(&k, 2.0));
         // A servo dithering ±3 counts at rest for 10 limits' worth of path: not stuck.
-        assert!(!stuck_after((0..10 * limit / 3).map(|i| if i % 2 == 0 {
-            3
-        } else {
-            -3
-        })));
+        assert!(!stuck_after(
+            code,
+            (0..10 * limit / 3).map(|i| if i % 2 == 0 { 3 } else { -3 })
+        ));
         // Turning one way 3 counts a tick past the limit: stuck.
-        assert!(stuck_after((0..limit / 3 + 2).map(|_| 3)));
+        assert!(stuck_after(code, (0..limit / 3 + 2).map(|_| 3)));
         // Up to the limit: not yet.
-        assert!(!stuck_after((0..limit / 3 - 1).map(|_| 3)));
+        assert!(!stuck_after(code, (0..limit / 3 - 1).map(|_| 3)));
+    }
+
+    #[test]
+    fn a_motor_turning_free_of_a_still_output_has_the_free_span() {
+        let k = SenseSettings::new(&Config::default()).expect("default configuration");
+        let (lost, free) = (k.lost_motor_counts as i32, k.free_motor_counts as i32);
+        assert!(k.driven_counts > 0 && free > lost + 6);
+        // Past the lost motion with no drive torque (half the driven floor): not yet stuck.
+        let idle = driven_code(&k, 0.5);
+        assert!(!stuck_after(idle, (0..lost / 3 + 2).map(|_| 3)));
+        // Past the free span: stuck, torque or not.
+        assert!(stuck_after(idle, (0..free / 3 + 2).map(|_| 3)));
+        // The same travel carrying the driven floor: stuck at the lost motion.
+        assert!(stuck_after(
+            driven_code(&k, 1.0),
+            (0..lost / 3 + 2).map(|_| 3)
+        ));
+        // The physical reading's preset: the input never turns free.
+        let p = SenseSettings::new(&Config::physical_reading()).expect("physical reading");
+        assert_eq!(p.driven_counts, 0);
     }
 }
