@@ -218,7 +218,7 @@ impl Thresholds {
         max_motor_speed_rad_s: 1800.0,
         max_lost_motion_rad: 0.2,   // the twin's lost motion is 0.03–0.1 rad
         free_input_travel_rad: 0.3, // where the Monte Carlo counts an input apart
-        driven_torque_nm: 1.0,      // turning free ≤ 0.41 N·m (offset); driven ≥ 2.0 N·m
+        driven_torque_nm: 1.0,      // turning free ≤ 0.41 N·m (offset); driven ≥ 1.99 N·m
         current_off_max_a: 3.0,
         adc_rail_time_s: 0.01, // overrunning chatter stalls the motor at the current limit ≈ 3 ms
         dead_current_nm: 0.0,  // off: the paper reading closes on almost no drive torque
