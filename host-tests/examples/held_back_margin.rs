@@ -10,7 +10,7 @@
 //! healthy row alone, for a large false-warning campaign).
 
 use host_tests::accuracy::run_monitor;
-use host_tests::family::{form, runs_and_seed, Family};
+use host_tests::family::{form, ExampleArgs};
 use host_tests::mc::{draw_in, draw_trace};
 use noback::monitor::{Estimate, Scene};
 use noback_twin::fault::FaultKind;
@@ -59,11 +59,9 @@ fn most_held_back(e: &[Estimate], from_s: f64) -> Option<f64> {
 }
 
 fn main() -> Result<(), String> {
-    let mut args = std::env::args().skip(1);
-    let (runs, seed) = runs_and_seed(&mut args, 300, 2026);
-    let rest: Vec<String> = args.collect();
-    let family = Family::from_args(&rest);
-    let healthy_only = rest.iter().any(|a| a == "healthy");
+    let a = ExampleArgs::parse(300, 2026);
+    let (runs, seed, family) = (a.runs, a.seed, a.family);
+    let healthy_only = a.has("healthy");
     println!(
         "family {}, seed {seed}, {runs} draws per row; N·m along the motion",
         family.name()

@@ -8,7 +8,7 @@
 //! [spread]` (defaults 300, 2026, the physical-default family).
 
 use host_tests::accuracy::run_monitor;
-use host_tests::family::{form, runs_and_seed, Family};
+use host_tests::family::{form, ExampleArgs};
 use host_tests::mc::{draw_in, draw_trace};
 use host_tests::stats::quantile_line;
 use noback::mechanism::Mechanism;
@@ -22,13 +22,11 @@ fn service(c: &Config, m: &Mechanism, mu: f64) -> f64 {
 }
 
 fn main() -> Result<(), String> {
-    let mut args = std::env::args().skip(1);
-    let (runs, seed) = runs_and_seed(&mut args, 300, 2026);
-    let rest: Vec<String> = args.collect();
-    let family = Family::from_args(&rest);
+    let a = ExampleArgs::parse(300, 2026);
+    let (runs, seed, family) = (a.runs, a.seed, a.family);
     let c = family.config();
     let model = service(&c, &c.mechanism, c.capacity_mu);
-    if rest.iter().any(|a| a == "spread") {
+    if a.has("spread") {
         let r = (0..runs)
             .map(|i| {
                 let m = draw_in(family, seed, i, None).scene.mechanism;

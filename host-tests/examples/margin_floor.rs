@@ -6,16 +6,14 @@
 //! (defaults 300, 2026, the physical-default family).
 
 use host_tests::accuracy::run_monitor;
-use host_tests::family::{form, runs_and_seed, Family};
+use host_tests::family::{form, ExampleArgs};
 use host_tests::mc::{draw_in, draw_trace};
 use host_tests::stats::quantile_line;
 use noback_twin::fault::FaultKind;
 
 fn main() -> Result<(), String> {
-    let mut args = std::env::args().skip(1);
-    let (runs, seed) = runs_and_seed(&mut args, 300, 2026);
-    let rest: Vec<String> = args.collect();
-    let family = Family::from_args(&rest);
+    let a = ExampleArgs::parse(300, 2026);
+    let (runs, seed, family) = (a.runs, a.seed, a.family);
     let c = family.config();
     println!(
         "family {}, seed {seed}, {runs} draws per row",

@@ -8,18 +8,17 @@
 //! 0..RUNS).
 
 use host_tests::accuracy::{compare, detection_latency_s, manifest_time, run_monitor};
-use host_tests::family::{form, runs_and_seed, Family};
+use host_tests::family::{form, ExampleArgs};
 use host_tests::mc::{draw_in, draw_trace, not_driven};
+use noback::fx::counter_delta;
 use noback_twin::fault::FaultKind;
 
 fn main() -> Result<(), String> {
-    let mut args = std::env::args().skip(1);
-    let (runs, seed) = runs_and_seed(&mut args, 100, 11);
-    let rest: Vec<String> = args.collect();
-    let family = Family::from_args(&rest);
-    let fault = (!rest.iter().any(|a| a == "healthy")).then_some(FaultKind::EncoderStuck);
+    let a = ExampleArgs::parse(100, 11);
+    let (runs, seed, family) = (a.runs, a.seed, a.family);
+    let fault = (!a.has("healthy")).then_some(FaultKind::EncoderStuck);
     let mut c = family.config();
-    if rest.iter().any(|a| a == "no-free-span") {
+    if a.has("no-free-span") {
         c.thresholds.driven_torque_nm = 0.0;
     }
     println!(
@@ -27,7 +26,7 @@ fn main() -> Result<(), String> {
         family.name(),
         fault.map_or("healthy".into(), |k| format!("{k:?}"))
     );
-    let listed: Vec<u64> = rest.iter().filter_map(|a| a.parse().ok()).collect();
+    let listed: Vec<u64> = a.rest.iter().filter_map(|a| a.parse().ok()).collect();
     let indices: Vec<u64> = if listed.is_empty() {
         (0..runs).collect()
     } else {
@@ -37,7 +36,7 @@ fn main() -> Result<(), String> {
         let d = draw_in(family, seed, i, fault);
         let trace = draw_trace(&d)?;
         let est = run_monitor(&trace, c)?;
-        if let (true, Some(f)) = (rest.iter().any(|a| a == "latency"), d.scene.faults.first()) {
+        if let (true, Some(f)) = (a.has("latency"), d.scene.faults.first()) {
             let latency = detection_latency_s(f, &trace, &compare(&trace, &est));
             println!("run {i} {} latency {latency:?}", form(&d.scene));
             continue;
@@ -45,7 +44,6 @@ fn main() -> Result<(), String> {
         let Some(at) = est.iter().position(|e| e.flags.sensor_fault) else {
             continue;
         };
-        let e = &est[at];
         let out = trace.rows[at].output_count;
         let mut start = at;
         while start > 0
@@ -60,7 +58,15 @@ fn main() -> Result<(), String> {
             .map(|e| e.drive_torque_nm.to_num::<f64>().abs())
             .sum::<f64>()
             / span.len() as f64;
-        let travel = (e.input_speed_rad_s.to_num::<f64>()).abs() * span.len() as f64 / c.tick_hz;
+        let sensors = &d.scene.sensors;
+        let travel = f64::from(
+            counter_delta(
+                trace.rows[start].motor_count,
+                trace.rows[at].motor_count,
+                sensors.motor_counter_bits,
+            )
+            .unsigned_abs(),
+        ) * sensors.input_rad_per_motor_count();
         let manifest = d
             .scene
             .faults
@@ -73,7 +79,7 @@ fn main() -> Result<(), String> {
             )
         });
         println!(
-            "run {i:6} {:8} {:?} load {:5.1} at {:.4} s{after}: still span {:5.1} ms, input ≈ {travel:.3} rad, mean |drive| {mean:.2} N·m, apart {}",
+            "run {i:6} {:8} {:?} load {:5.1} at {:.4} s{after}: still span {:5.1} ms, input {travel:.3} rad, mean |drive| {mean:.2} N·m, apart {}",
             form(&d.scene),
             d.scene.kind,
             d.scene.load_torque_nm,

@@ -107,6 +107,37 @@ pub fn runs_and_seed(args: &mut impl Iterator<Item = String>, runs: u64, seed: u
     (next(runs, "RUNS"), next(seed, "SEED"))
 }
 
+/// A family example's command line: `[RUNS] [SEED]` ([`runs_and_seed`]), then words, among
+/// which `plant` picks [`Family::Plant`].
+pub struct ExampleArgs {
+    pub runs: u64,
+    pub seed: u64,
+    pub family: Family,
+    /// The words after `[RUNS] [SEED]`.
+    pub rest: Vec<String>,
+}
+
+impl ExampleArgs {
+    /// The process's arguments, `RUNS` and `SEED` defaulted to `runs` and `seed`.
+    pub fn parse(runs: u64, seed: u64) -> ExampleArgs {
+        let mut args = std::env::args().skip(1);
+        let (runs, seed) = runs_and_seed(&mut args, runs, seed);
+        let rest: Vec<String> = args.collect();
+        let family = Family::from_args(&rest);
+        ExampleArgs {
+            runs,
+            seed,
+            family,
+            rest,
+        }
+    }
+
+    /// Whether `word` was given.
+    pub fn has(&self, word: &str) -> bool {
+        self.rest.iter().any(|a| a == word)
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -205,8 +205,9 @@ mod tests {
         let slowing = |t: u32| (4.0 - 20.0 * (f64::from(t) - 100.0).max(0.0) / 1e4).max(0.0);
         assert_eq!(slip_at(slowing), None);
         let rad_per_count = Config::default().sensors.output_rad_per_count();
-        assert!(2_100.0 * rad_per_count > 2.0 * limit); // the travel to the stop
-                                                        // Slowing to 2 rad/s and then carried steadily: called within a window of going steady.
+        // The travel to the stop.
+        assert!(2_100.0 * rad_per_count > 2.0 * limit);
+        // Slowing to 2 rad/s and then carried steadily: called within a window of going steady.
         let steady_after = slip_at(|t| slowing(t).max(2.0)).unwrap_or(0.0);
         assert!(steady_after > 2.0 * limit, "{steady_after}");
         let steady_from = 100.0 + 2.0 / 20.0 * 1e4; // ticks, one count each
