@@ -419,8 +419,11 @@ impl State {
             refresh_load(&mut self.load, k);
         }
         // The pack's torque is known against an opposing load only where both socket faces
-        // clamp (`learn_opposed`), and not at all while the load's sign is a guess (`alt`).
-        let learnable = self.load.decided() && (k.load.learn_opposed || c.load_along);
+        // clamp (`learn_opposed`), not on a guessed sign (`alt`), nor after a drive whose
+        // input ran ahead of the output (where the pack engages is unknown).
+        let learnable = self.load.decided()
+            && (k.load.learn_opposed || c.load_along)
+            && !self.classify.input_ran_ahead(&k.scene);
         if moving_ok && !x.drive && learnable {
             let measured = load.saturating_sub(o.net);
             self.load.learn_health(&k.load, c.dir.apply(measured));

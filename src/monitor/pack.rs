@@ -191,6 +191,12 @@ impl Dir {
         self.0 * other.0 < 0
     }
 
+    /// `dir·x` for a count, saturating.
+    #[inline]
+    pub fn apply_count(self, x: i32) -> i32 {
+        x.saturating_mul(self.0)
+    }
+
     /// `dir·x`, saturating.
     #[inline]
     pub fn apply(self, x: Q16) -> Q16 {

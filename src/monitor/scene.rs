@@ -14,6 +14,10 @@
 //! driving one for a `DrivingPack::SpringOnly` pack) as a guess (`Classified::guessed`).
 //! After the first settled decision of a drive, the other reading must be wanted for
 //! `engage_settle_s` (and the step check must not be counting) before it switches.
+//!
+//! | quantity | format | range | resolution |
+//! |---|---|---|---|
+//! | shafts' travel per window, averaged | `i32` counts × 32, saturating | ±2^26 counts a window | 1/32 count |
 
 use super::config::{Config, ConfigError, DrivingPack};
 use super::convert::{counts, positive, q16, ticks};
@@ -25,6 +29,10 @@ use super::schedule::WINDOW;
 use super::sense::Sensed;
 use super::{convert::scale, Scene};
 use crate::fx::{counter_delta, Q16};
+
+/// Windows each shaft's travel is averaged over (51 ms at 10 kHz): a power of two.
+const AHEAD_SHIFT: u32 = 5;
+const AHEAD_WINDOWS: u32 = 1 << AHEAD_SHIFT;
 
 /// The classifier's constants.
 #[cfg_attr(
@@ -45,6 +53,9 @@ pub(crate) struct SceneSettings {
     motor_to_out: Scale<30>,
     /// Relative travel (output counts) over a window within the synchronism band.
     sync_band_counts: i32,
+    /// The input's mean gain on the output per window (output counts × [`AHEAD_WINDOWS`])
+    /// beyond which it runs ahead: the stick speed.
+    ahead_counts: i32,
     /// With no load known, take the overrunning reading (a relieved pack: its overrunning
     /// drive torque lies above the drag); a spring-only pack overruns on almost none.
     overrun_when_unknown: bool,
@@ -76,6 +87,10 @@ impl SceneSettings {
             sync_band_counts: counts(
                 t.sync_speed_band_rad_s * f64::from(WINDOW.ticks) * (1.0 / tick_hz) / out_rad,
                 "thresholds.sync_speed_band_rad_s",
+            )?,
+            ahead_counts: counts(
+                t.stick_speed_rad_s * f64::from(WINDOW.ticks * AHEAD_WINDOWS) / tick_hz / out_rad,
+                "thresholds.stick_speed_rad_s",
             )?,
             overrun_when_unknown: c.driving_pack == DrivingPack::Relieved,
         })
@@ -181,6 +196,10 @@ pub(crate) struct Classify {
     last_dir: Dir,
     /// Ticks of steady driving, counted in windows on the synchronism slot.
     steady_ticks: u32,
+    /// Each shaft's travel along the motion per window (motor, output counts), averaged over
+    /// the last [`AHEAD_WINDOWS`] of the drive (× [`AHEAD_WINDOWS`], saturating).
+    ahead_motor: i32,
+    ahead_out: i32,
     sync_out: u32,
     sync_motor: u32,
     /// Ticks since the last classification.
@@ -196,6 +215,8 @@ impl Classify {
             phase_ticks: 0,
             last_dir: Dir::NONE,
             steady_ticks: 0,
+            ahead_motor: 0,
+            ahead_out: 0,
             sync_out: 0,
             sync_motor: 0,
             since: 0,
@@ -216,6 +237,7 @@ impl Classify {
         if x.drive_edge {
             self.steady_ticks = 0;
             self.phase = if x.drive {
+                (self.ahead_motor, self.ahead_out) = (0, 0);
                 Phase::Driving(Reading::none())
             } else {
                 Phase::Braking
@@ -345,6 +367,16 @@ impl Classify {
         }
     }
 
+    /// The last drive's input ran ahead of the output along the motion (the paper reading's
+    /// ideal speed input on a load its pack nearly holds): drive off, the pack engages only
+    /// once the output has caught it up, somewhere unknown.
+    pub fn input_ran_ahead(&self, k: &SceneSettings) -> bool {
+        k.motor_to_out
+            .apply(self.ahead_motor)
+            .saturating_sub(self.ahead_out)
+            > k.ahead_counts
+    }
+
     /// Whether the brake is locked (holding).
     pub fn locked(&self) -> bool {
         self.phase == Phase::Holding
@@ -352,19 +384,24 @@ impl Classify {
 
     /// Steady driving: the travel of both shafts over the last window agrees within the band
     /// (measured on the counters, not the observer, whose speed lags a step of the model's
-    /// torque). An output that runs away from the input restarts the count.
+    /// torque). An output that runs away from the input restarts the count. Each shaft's
+    /// travel is averaged too ([`Classify::input_ran_ahead`]).
     /// On the window lane's [`Slot::Sync`] with the drive on.
     pub fn sync_window(&mut self, k: &SceneSettings, x: &Sensed, w: Q16) {
         let dir = Dir::of(w, k.stick_speed);
         let d_o = counter_delta(self.sync_out, x.out, k.out_bits);
         let d_m = counter_delta(self.sync_motor, x.motor, k.motor_bits);
         (self.sync_out, self.sync_motor) = (x.out, x.motor);
-        let synchronous = k
-            .motor_to_out
-            .apply(d_m)
-            .saturating_sub(d_o)
-            .saturating_abs()
-            <= k.sync_band_counts;
+        let gain = k.motor_to_out.apply(d_m).saturating_sub(d_o);
+        let synchronous = gain.saturating_abs() <= k.sync_band_counts;
+        if !dir.is_none() {
+            let average = |mean: i32, d: i32| {
+                mean.saturating_add(dir.apply_count(d))
+                    .saturating_sub(mean >> AHEAD_SHIFT)
+            };
+            self.ahead_motor = average(self.ahead_motor, d_m);
+            self.ahead_out = average(self.ahead_out, d_o);
+        }
         self.steady_ticks = if !dir.is_none() && synchronous {
             self.steady_ticks
                 .saturating_add(x.n.saturating_mul(WINDOW.ticks))
@@ -414,5 +451,78 @@ impl Reading {
             }
         }
         r
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Runs `windows` synchronism windows of a drive, the output and the input turning at
+    /// `speeds` (rad/s) from the angles `at` (rad); returns where they end.
+    fn drive(cl: &mut Classify, speeds: (f64, f64), windows: u32, at: (f64, f64)) -> (f64, f64) {
+        let c = Config::default();
+        let k = SceneSettings::new(&c, 1).expect("default configuration");
+        let (out_rad, in_rad) = (
+            c.sensors.output_rad_per_count(),
+            c.sensors.input_rad_per_motor_count(),
+        );
+        let h = f64::from(WINDOW.ticks) / c.tick_hz;
+        let mut pos = at;
+        for _ in 0..windows {
+            pos = (pos.0 + speeds.0 * h, pos.1 + speeds.1 * h);
+            let x = Sensed {
+                n: 1,
+                drive: true,
+                out: (pos.0 / out_rad).round() as u32 & ((1 << k.out_bits) - 1),
+                motor: (pos.1 / in_rad).round() as u32
+                    & (u32::MAX >> (32 - u32::from(k.motor_bits))),
+                ..Sensed::NONE
+            };
+            cl.sync_window(&k, &x, Q16::from_num(speeds.0));
+        }
+        pos
+    }
+
+    #[test]
+    fn an_input_gaining_on_the_output_faster_than_the_stick_speed_ran_ahead() {
+        let k = SceneSettings::new(&Config::default(), 1).expect("default configuration");
+        let start = Sensed {
+            n: 1,
+            drive: true,
+            drive_edge: true,
+            first: true,
+            ..Sensed::NONE
+        };
+        let mut cl = Classify::new();
+        cl.tick(&start, &Observed::NONE);
+        // Together at 5 rad/s for 0.1 s: not ahead.
+        let at = drive(&mut cl, (5.0, 5.0), 64, (0.0, 0.0));
+        assert!(!cl.input_ran_ahead(&k));
+        // The input 0.5 rad/s faster (18198 and 57429 at seed 4242: 0.55–0.64): ahead.
+        let at = drive(&mut cl, (5.0, 5.5), 64, at);
+        assert!(cl.input_ran_ahead(&k));
+        // The drive off keeps the verdict; a new drive starts its own.
+        cl.tick(
+            &Sensed {
+                drive: false,
+                ..start
+            },
+            &Observed::NONE,
+        );
+        assert!(cl.input_ran_ahead(&k));
+        cl.tick(
+            &Sensed {
+                first: false,
+                ..start
+            },
+            &Observed::NONE,
+        );
+        assert!(!cl.input_ran_ahead(&k));
+        // Below the stick speed, or the output gaining: not ahead.
+        let at = drive(&mut cl, (5.0, 5.2), 128, at);
+        assert!(!cl.input_ran_ahead(&k));
+        drive(&mut cl, (5.5, 5.0), 128, at);
+        assert!(!cl.input_ran_ahead(&k));
     }
 }
