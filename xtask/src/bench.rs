@@ -24,6 +24,7 @@ pub mod charts;
 pub mod explicit;
 mod host_speed;
 mod pages;
+mod report;
 mod stability_map;
 mod variants;
 pub mod work_precision;
@@ -128,10 +129,146 @@ fn opt(v: Option<f64>) -> String {
     v.map_or(String::new(), |x| format!("{x:.6e}"))
 }
 
+/// The braking scenes: the reduced model's references, in both readings.
+const BRAKING_SCENES: [(&str, SceneKind, BrakingScene); 2] = [
+    (
+        "reverse_load",
+        SceneKind::ReverseLoad,
+        BrakingScene::REVERSE,
+    ),
+    (
+        "forward_load",
+        SceneKind::ForwardLoad,
+        BrakingScene::FORWARD,
+    ),
+];
+/// The scenes without a braking, as the twin's built-ins run them: at rest under the load with
+/// the drive off, and driven against the load (opening) throughout.
+const STILL_SCENES: [(&str, SceneKind, BrakingScene); 2] = [
+    (
+        "hold",
+        SceneKind::Hold,
+        BrakingScene {
+            speed_ref_rad_s: 0.0,
+            release_s: 0.0,
+        },
+    ),
+    (
+        "drive",
+        SceneKind::Drive,
+        BrakingScene {
+            speed_ref_rad_s: -13.78,
+            release_s: f64::INFINITY,
+        },
+    ),
+];
+
+/// The shipped monitor's point: M3 instructions per tick (the interrupt's part and its
+/// background call) and its braking-torque RMS on reverse_load against each reading (N·m).
+struct MonitorPoint {
+    insns: f64,
+    err_paper: f64,
+    err_phys: f64,
+}
+
+/// The twin's references: each scene's paper reading with its braking scene, and the
+/// braking scenes' physical reading.
+struct References {
+    paper: Vec<(&'static str, BrakingScene, Vec<Sample>)>,
+    physical: Vec<(&'static str, Vec<Sample>)>,
+}
+
+impl References {
+    fn physical(&self, name: &str) -> Option<&[Sample]> {
+        self.physical
+            .iter()
+            .find(|(n, _)| *n == name)
+            .map(|(_, r)| r.as_slice())
+    }
+}
+
+/// The chart's two panels (`(M3 insns/s, torque RMS, label)`) and their Pareto fronts.
+struct Fronts {
+    pts: Vec<(f64, f64, String)>,
+    front: Vec<usize>,
+    pts_phys: Vec<(f64, f64, String)>,
+    front_phys: Vec<usize>,
+}
+
 /// Entry.
 pub fn main(args: &[String]) -> Result<i32, String> {
-    let mut quick = false;
-    let mut json = false;
+    let (quick, json) = options(args)?;
+    let t0 = Instant::now();
+    crate::bootstrap::ensure_all()?;
+    eprintln!("bench: M3 instruction counts under QEMU (noback-bench)");
+    let m3 = core_costs(Core::M3, false)?;
+    eprintln!("bench: Cortex-M0 instruction counts (noback-bench under QEMU)");
+    let m0 = core_costs(Core::M0, false)?;
+    let monitor = shipped_monitor()?;
+    let mut variants: Vec<Variant> = Vec::new();
+    let refs = twin_variants(quick, &mut variants)?;
+    quasi_static_variants(&refs, &mut variants);
+    reduced_variants(&refs, &m3, &mut variants)?;
+    eprintln!("bench: stability of explicit steps on the full physical model");
+    let stab = stability_map::run(quick)?;
+
+    // Outputs: the pages under docs/results, or with `--json` a scratch directory under target/.
+    let dir = if json {
+        workspace_root().join("target").join("bench-json")
+    } else {
+        workspace_root().join("docs").join("results")
+    };
+    std::fs::create_dir_all(&dir).map_err(|e| e.to_string())?;
+    let write = |name: &str, text: &str| {
+        std::fs::write(dir.join(name), text).map_err(|e| format!("{name}: {e}"))
+    };
+    let rows: Vec<_> = variants
+        .iter()
+        .map(|v| host_speed::Row {
+            family: &v.family,
+            format: &v.format,
+            method: &v.method,
+            scene: v.scene,
+            ns_per_step: v.host_ns_per_step,
+        })
+        .collect();
+    write("host-speed.md", &host_speed::page(&rows, quick))?;
+    let csv = pages::speed_accuracy_csv(
+        &variants,
+        monitor.insns,
+        monitor.err_paper,
+        monitor.err_phys,
+    );
+    write("speed-accuracy.csv", &csv)?;
+    stability_map::write(&dir, &stab)?;
+    let fronts = chart(&dir, &variants, &monitor)?;
+    let names: Vec<&str> = BRAKING_SCENES
+        .iter()
+        .chain(STILL_SCENES.iter())
+        .map(|s| s.0)
+        .collect();
+    let (md, cheapest) = pages::cheapest(&variants, &names, monitor.insns)?;
+    write("cheapest-per-scene.md", &md)?;
+    write("cost-by-core.md", &pages::cost_by_core(&m3, &m0))?;
+    let report = report::Report {
+        variants: &variants,
+        fronts: &fronts,
+        monitor: &monitor,
+        cheapest: &cheapest,
+        stab: &stab,
+        t0,
+    };
+    if json {
+        report.print_json();
+    } else {
+        report.print_table();
+    }
+    Ok(0)
+}
+
+/// `[--quick] [--json]`.
+fn options(args: &[String]) -> Result<(bool, bool), String> {
+    let (mut quick, mut json) = (false, false);
     for a in args {
         match a.as_str() {
             "--quick" => quick = true,
@@ -143,56 +280,18 @@ pub fn main(args: &[String]) -> Result<i32, String> {
             }
         }
     }
-    let t0 = Instant::now();
-    crate::bootstrap::ensure_all()?;
-    let reps = if quick { 3 } else { 11 };
-    let scenes = [
-        (
-            "reverse_load",
-            SceneKind::ReverseLoad,
-            BrakingScene::REVERSE,
-        ),
-        (
-            "forward_load",
-            SceneKind::ForwardLoad,
-            BrakingScene::FORWARD,
-        ),
-    ];
-    // The scenes without braking, as the twin's built-ins run them: at rest under the load with
-    // the drive off, and driven against the load (opening) throughout.
-    let still_scenes = [
-        (
-            "hold",
-            SceneKind::Hold,
-            BrakingScene {
-                speed_ref_rad_s: 0.0,
-                release_s: 0.0,
-            },
-        ),
-        (
-            "drive",
-            SceneKind::Drive,
-            BrakingScene {
-                speed_ref_rad_s: -13.78,
-                release_s: f64::INFINITY,
-            },
-        ),
-    ];
+    Ok((quick, json))
+}
 
-    eprintln!("bench: M3 instruction counts under QEMU (noback-bench)");
-    let m3 = core_costs(Core::M3, false)?;
-    eprintln!("bench: Cortex-M0 instruction counts (noback-bench under QEMU)");
-    let m0 = core_costs(Core::M0, false)?;
-    let m3_of = |f: &str, m: &str| m3.iter().find(|(a, b, _, _)| a == f && b == m).map(|x| x.2);
+/// The shipped monitor: its cost in `cargo xtask run`'s replay on the M3, its estimate on
+/// reverse_load against both readings.
+fn shipped_monitor() -> Result<MonitorPoint, String> {
     eprintln!("bench: the shipped monitor (cargo xtask run's replay, M3)");
     let (shipped, _) = crate::run::replay_report("reverse_load", Core::M3, None, None, false)?;
-    // All the monitor's work per tick: the interrupt's part and its background (PendSV) call.
-    let shipped_insns = shipped["insns_per_step_mean"].as_f64().unwrap_or(f64::NAN)
-        + shipped["background_insns_per_call_mean"]
-            .as_f64()
-            .unwrap_or(f64::NAN);
+    let per_tick = |key: &str| shipped[key].as_f64().unwrap_or(f64::NAN);
+    let insns = per_tick("insns_per_step_mean") + per_tick("background_insns_per_call_mean");
     eprintln!("bench: the shipped monitor's estimate on reverse_load against both readings");
-    let monitor_err = |reading: Reading| -> Result<f64, String> {
+    let err = |reading: Reading| -> Result<f64, String> {
         let (_, acc) = host_tests::accuracy::monitor_on_scene(&Scene::builtin(
             SceneKind::ReverseLoad,
             reading,
@@ -204,19 +303,27 @@ pub fn main(args: &[String]) -> Result<i32, String> {
         }
         Ok((s / f64::max(n, 1.0)).sqrt())
     };
-    let monitor_paper = monitor_err(Reading::Paper)?;
-    let monitor_phys = monitor_err(Reading::Physical)?;
+    Ok(MonitorPoint {
+        insns,
+        err_paper: err(Reading::Paper)?,
+        err_phys: err(Reading::Physical)?,
+    })
+}
 
-    let mut variants: Vec<Variant> = Vec::new();
-    // Twin at several tolerances, both readings, against its tightest run.
+/// The twin at several tolerances, both readings, against its tightest run; returns the
+/// references the other variants are measured against.
+fn twin_variants(quick: bool, variants: &mut Vec<Variant>) -> Result<References, String> {
+    let reps = if quick { 3 } else { 5 };
     let tols: &[f64] = if quick {
         &[1e-3, 1e-5, 1e-7]
     } else {
         &[1e-2, 1e-3, 1e-4, 1e-5, 1e-6, 1e-7, 1e-8]
     };
-    let mut refs = Vec::new();
-    let mut phys_refs: Vec<(&str, Vec<Sample>)> = Vec::new();
-    for (name, kind, bs) in scenes {
+    let mut refs = References {
+        paper: Vec::new(),
+        physical: Vec::new(),
+    };
+    for (name, kind, bs) in BRAKING_SCENES {
         for reading in [Reading::Paper, Reading::Physical] {
             let ref_tol = if reading == Reading::Paper {
                 REF_TOL
@@ -233,7 +340,7 @@ pub fn main(args: &[String]) -> Result<i32, String> {
                 scene.tolerance = tol;
                 let mut walls = Vec::new();
                 let mut last = None;
-                for _ in 0..reps.min(5) {
+                for _ in 0..reps {
                     let r = run(&scene).map_err(|e| format!("twin at {tol}: {e:?}"))?;
                     walls.push(r.wall_s);
                     last = Some(r);
@@ -270,24 +377,23 @@ pub fn main(args: &[String]) -> Result<i32, String> {
                 });
             }
             if reading == Reading::Paper {
-                refs.push((name, bs, reference));
+                refs.paper.push((name, bs, reference));
             } else {
-                phys_refs.push((name, reference));
+                refs.physical.push((name, reference));
             }
         }
     }
-    for (name, kind, bs) in still_scenes {
+    for (name, kind, bs) in STILL_SCENES {
         eprintln!("bench: twin {name} (paper) reference at tol {REF_TOL}");
-        refs.push((name, bs, reference(kind, Reading::Paper, REF_TOL)?));
+        refs.paper
+            .push((name, bs, reference(kind, Reading::Paper, REF_TOL)?));
     }
-    let phys_of = |name: &str| {
-        phys_refs
-            .iter()
-            .find(|(n, _)| *n == name)
-            .map(|(_, r)| r.as_slice())
-    };
-    // The quasi-static candidate (no state to advance: no instructions spent on a model step).
-    for (name, bs, reference) in &refs {
+    Ok(refs)
+}
+
+/// The quasi-static candidate (no state to advance: no instructions spent on a model step).
+fn quasi_static_variants(refs: &References, variants: &mut Vec<Variant>) {
+    for (name, bs, reference) in &refs.paper {
         let duration = reference.last().map_or(1.0, |s| s.t_s);
         let rows = run_quasi_static(*bs, 10_000, duration);
         variants.push(Variant {
@@ -297,13 +403,21 @@ pub fn main(args: &[String]) -> Result<i32, String> {
             rate_hz: 10_000.0,
             scene: name,
             e: errors(&rows, reference, bs.release_s),
-            e_phys: phys_of(name).map(|r| errors(&rows, r, bs.release_s)),
+            e_phys: refs.physical(name).map(|r| errors(&rows, r, bs.release_s)),
             m3_insns_per_step: Some(0.0),
             host_ns_per_step: 0.0,
             rhs_evals: 0.0,
         });
     }
-    // The reduced model.
+}
+
+/// Every format × integrator × rate of the reduced model on every scene.
+fn reduced_variants(
+    refs: &References,
+    m3: &pages::CoreCosts,
+    variants: &mut Vec<Variant>,
+) -> Result<(), String> {
+    let m3_of = |f: &str, m: &str| m3.iter().find(|(a, b, _, _)| a == f && b == m).map(|x| x.2);
     eprintln!("bench: host ns per step (criterion, study/benches/reduced_step.rs)");
     run_criterion()?;
     let total = FORMATS.len() * Method::ALL.len();
@@ -313,7 +427,7 @@ pub fn main(args: &[String]) -> Result<i32, String> {
             done += 1;
             eprintln!("bench: reduced {fmt} {} ({done}/{total})", method.name());
             let ns = criterion_ns(fmt, method)?;
-            for (name, bs, reference) in &refs {
+            for (name, bs, reference) in &refs.paper {
                 for rate in RATES {
                     let duration = reference.last().map_or(1.0, |s| s.t_s);
                     let rows = run_reduced_by_name(fmt, method, *bs, rate, duration);
@@ -324,7 +438,7 @@ pub fn main(args: &[String]) -> Result<i32, String> {
                         rate_hz: f64::from(rate),
                         scene: name,
                         e: errors(&rows, reference, bs.release_s),
-                        e_phys: phys_of(name).map(|r| errors(&rows, r, bs.release_s)),
+                        e_phys: refs.physical(name).map(|r| errors(&rows, r, bs.release_s)),
                         m3_insns_per_step: m3_of(fmt, method.name()),
                         host_ns_per_step: ns,
                         rhs_evals: f64::from(method.rhs_per_step()) * f64::from(rate),
@@ -333,35 +447,16 @@ pub fn main(args: &[String]) -> Result<i32, String> {
             }
         }
     }
-    eprintln!("bench: stability of explicit steps on the full physical model");
-    let stab = stability_map::run(quick)?;
+    Ok(())
+}
 
-    // Outputs: the pages under docs/results, or with `--json` a scratch directory under target/.
-    let dir = if json {
-        workspace_root().join("target").join("bench-json")
-    } else {
-        workspace_root().join("docs").join("results")
-    };
-    std::fs::create_dir_all(&dir).map_err(|e| e.to_string())?;
-    let rows: Vec<_> = variants
-        .iter()
-        .map(|v| host_speed::Row {
-            family: &v.family,
-            format: &v.format,
-            method: &v.method,
-            scene: v.scene,
-            ns_per_step: v.host_ns_per_step,
-        })
-        .collect();
-    std::fs::write(dir.join("host-speed.md"), host_speed::page(&rows, quick))
-        .map_err(|e| e.to_string())?;
-    let csv = pages::speed_accuracy_csv(&variants, shipped_insns, monitor_paper, monitor_phys);
-    std::fs::write(dir.join("speed-accuracy.csv"), &csv).map_err(|e| e.to_string())?;
-
-    stability_map::write(&dir, &stab)?;
-
-    // Chart and Pareto fronts: reduced variants on reverse_load, braking-torque RMS (the
-    // quantity the monitor estimates) against each reading, with the shipped monitor's point.
+/// The chart and its Pareto fronts: reduced variants on reverse_load, braking-torque RMS (the
+/// quantity the monitor estimates) against each reading, with the shipped monitor's point.
+fn chart(
+    dir: &std::path::Path,
+    variants: &[Variant],
+    monitor: &MonitorPoint,
+) -> Result<Fronts, String> {
     let rev: Vec<&Variant> = variants
         .iter()
         .filter(|v| v.family == "reduced" && v.scene == "reverse_load")
@@ -384,106 +479,21 @@ pub fn main(args: &[String]) -> Result<i32, String> {
                 title: "against the paper reading (tol 1e-10)",
                 pts: &pts,
                 front: &front,
-                monitor_err: monitor_paper,
+                monitor_err: monitor.err_paper,
             },
             charts::Panel {
                 title: "against the physical reading (tol 1e-9), the monitor's",
                 pts: &pts_phys,
                 front: &front_phys,
-                monitor_err: monitor_phys,
+                monitor_err: monitor.err_phys,
             },
         ],
-        shipped_insns * 1e4,
+        monitor.insns * 1e4,
     )?;
-
-    // Cheapest per scene.
-    let names: Vec<&str> = scenes
-        .iter()
-        .chain(still_scenes.iter())
-        .map(|s| s.0)
-        .collect();
-    let (md, cheapest_rows) = pages::cheapest(&variants, &names, shipped_insns)?;
-    std::fs::write(dir.join("cheapest-per-scene.md"), &md).map_err(|e| e.to_string())?;
-
-    let cores_md = pages::cost_by_core(&m3, &m0);
-    std::fs::write(dir.join("cost-by-core.md"), &cores_md).map_err(|e| e.to_string())?;
-
-    if json {
-        let vs: Vec<_> = variants
-            .iter()
-            .map(|v| {
-                serde_json::json!({
-                    "family": v.family, "format": v.format, "method": v.method,
-                    "rate_hz": v.rate_hz, "scene": v.scene,
-                    "angle_rms_rad": v.e.angle_rms, "speed_rms_rad_s": v.e.speed_rms,
-                    "force_rms_pct": v.e.force_rms_pct, "torque_rms_nm": v.e.torque_rms,
-                    "lock_err_s": v.e.lock_err_s, "meets_targets": v.e.meets_targets(),
-                    "m3_insns_per_step": v.m3_insns_per_step, "host_ns_per_step": v.host_ns_per_step,
-                })
-            })
-            .collect();
-        let front_labels: Vec<&String> = front
-            .iter()
-            .filter_map(|&i| pts.get(i).map(|p| &p.2))
-            .collect();
-        println!(
-            "{}",
-            serde_json::json!({
-                "variants": vs, "pareto_reverse_load": front_labels,
-                "pareto_reverse_load_physical": front_phys.iter().filter_map(|&i| pts_phys.get(i).map(|p| &p.2)).collect::<Vec<_>>(),
-                "monitor": {"m3_insns_per_s": shipped_insns * 1e4, "torque_rms_paper_nm": monitor_paper, "torque_rms_physical_nm": monitor_phys},
-                "cheapest": cheapest_rows, "shipped_insns_per_step": shipped_insns,
-                "stability": stab.iter().map(|r| serde_json::json!({"method": r.method, "parameter": r.parameter, "scale": r.scale, "h_us": r.h_us, "verdict": r.verdict})).collect::<Vec<_>>(),
-                "seconds": t0.elapsed().as_secs_f64(),
-            })
-        );
-    } else {
-        println!("format         method      rate   scene         angle RMS  speed RMS  force%  lock ms  M3 insn/step  host ns  targets");
-        for v in variants.iter().filter(|v| v.family == "reduced") {
-            println!(
-                "{:<14} {:<11} {:>3}k  {:<12} {:>9.2e}  {:>9.2e}  {:>6.3}  {:>7.2}  {:>12.0}  {:>7.1}  {}",
-                v.format,
-                v.method,
-                v.rate_hz / 1e3,
-                v.scene,
-                v.e.angle_rms,
-                v.e.speed_rms,
-                v.e.force_rms_pct,
-                v.e.lock_err_s * 1e3,
-                v.m3_insns_per_step.unwrap_or(f64::NAN),
-                v.host_ns_per_step,
-                if v.e.meets_targets() { "yes" } else { "no" }
-            );
-        }
-        println!("\ntwin against its tightest run (paper 1e-10, physical 1e-9):");
-        for v in variants.iter().filter(|v| v.family != "reduced") {
-            println!(
-                "{:<15} {:<24} {:<12} angle RMS {:.2e}  speed RMS {:.2e}  lock err {:.2} ms  rhs evals {:.0}  host ns/step {:.0}",
-                v.family, v.method, v.scene, v.e.angle_rms, v.e.speed_rms, v.e.lock_err_s * 1e3, v.rhs_evals, v.host_ns_per_step
-            );
-        }
-        println!("\nPareto front (reverse_load, braking-torque RMS vs M3 insns/s, paper reading):");
-        for &i in &front {
-            if let Some(p) = pts.get(i) {
-                println!("  {:<40} {:.3e} insns/s  {:.2e} N·m", p.2, p.0, p.1);
-            }
-        }
-        println!("\nstability (full physical model, explicit fixed steps):");
-        for r in &stab {
-            println!(
-                "  {:<5} {:>4}×{:<5} h={:>5} µs  {}",
-                r.method, r.parameter, r.scale, r.h_us, r.verdict
-            );
-        }
-        println!("\ncheapest per scene:");
-        for (s, l) in &cheapest_rows {
-            println!("  {s}: {l}");
-        }
-        println!("shipped monitor: {shipped_insns:.1} M3 insns/step");
-        println!(
-            "\nwrote docs/results/speed-accuracy.{{csv,svg}}, stability.{{csv,svg}}, cheapest-per-scene.md, cost-by-core.md, host-speed.md in {:.0} s",
-            t0.elapsed().as_secs_f64()
-        );
-    }
-    Ok(0)
+    Ok(Fronts {
+        pts,
+        front,
+        pts_phys,
+        front_phys,
+    })
 }

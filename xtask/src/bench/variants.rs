@@ -146,15 +146,20 @@ pub fn run_reduced_by_name(
 /// Runs the criterion benchmark `study/benches/reduced_step.rs` (host nanoseconds per
 /// step of every format × integrator).
 pub fn run_criterion() -> Result<(), String> {
-    shell::run(cargo().args([
-        "bench",
-        "-p",
-        "noback-study",
-        "--bench",
-        "reduced_step",
-        "--",
-        "--noplot",
-    ]))
+    // Criterion's report goes to stderr: with `--json` stdout carries the JSON line alone.
+    shell::run(
+        cargo()
+            .args([
+                "bench",
+                "-p",
+                "noback-study",
+                "--bench",
+                "reduced_step",
+                "--",
+                "--noplot",
+            ])
+            .stdout(std::io::stderr()),
+    )
 }
 
 /// Criterion's mean estimate of one variant (ns per step), from its `estimates.json`.
