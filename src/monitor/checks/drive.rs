@@ -10,7 +10,7 @@
 //!
 //! | quantity | format | range | resolution |
 //! |---|---|---|---|
-//! | implied load, its history | [`Q16`], saturating | ±32 768 N·m | 1.5e-5 N·m |
+//! | implied load, drive torque, their histories, the drive torque's floor | [`Q16`], saturating | ±32 768 N·m | 1.5e-5 N·m |
 //! | persistence counters | `u32` ticks, saturating | — | 1 tick |
 
 use crate::fx::{lowpass, Gain, Q16};
@@ -20,6 +20,10 @@ use crate::monitor::pack::{Dir, PackRatios, PackSettings};
 use crate::monitor::scale::Scale;
 use crate::monitor::schedule::SLOW;
 use crate::monitor::Flags;
+
+/// The drive torque's floor rises `2^FLOOR_RISE_SLOWER` times slower than its history follows
+/// (16×: 0.4 s against 25.6 ms): a chatter's 10 N·m pulse of 20 ms lifts it ≤ 0.5 N·m.
+const FLOOR_RISE_SLOWER: u32 = 4;
 
 /// The drive checks' constants.
 #[cfg_attr(
@@ -113,6 +117,9 @@ pub(crate) struct DriveChecks {
     step_ref: Q16,
     /// Recent history (the same low-pass) of the drive torque along the motion.
     drive_ref: Q16,
+    /// Its floor: falls as the history does, rises 16× slower, so that the quiet spells of an
+    /// overrunning chatter are no lighter step against the pulses between them.
+    drive_floor: Q16,
     /// The history has been seeded in this phase of the drive.
     step_ref_valid: bool,
     /// Ticks a history seeded on a guessed reading still waits before it judges a lighter step
@@ -246,12 +253,13 @@ impl DriveChecks {
             });
             let needed = share.max(p.step_drive_min);
             let drive_step = t.drive.saturating_sub(self.drive_ref);
+            let below_floor = t.drive.saturating_sub(self.drive_floor);
             // A history seeded on a guess (a power-on into a running drive) may hold the
             // servo's settling: no lighter step until it has followed for its time constant.
             self.guess_wait_ticks = self.guess_wait_ticks.saturating_sub(counted);
             let (harder, lighter) = (
                 harder && drive_step > needed,
-                lighter && drive_step < needed.saturating_neg() && self.guess_wait_ticks == 0,
+                lighter && below_floor < needed.saturating_neg() && self.guess_wait_ticks == 0,
             );
             // The harder half waits out a pending change towards overrunning (the light-load
             // chatter of continuous closing pulses the drive torque by 9 N·m and makes the
@@ -285,10 +293,22 @@ impl DriveChecks {
                         .to_bits()
                         .wrapping_shr(p.drive_ref_shift), // ≤ 30: exact
                 ));
+                let floor_shift = if t.drive > self.drive_floor {
+                    p.drive_ref_shift.saturating_add(FLOOR_RISE_SLOWER).min(31)
+                } else {
+                    p.drive_ref_shift
+                };
+                self.drive_floor = self.drive_floor.saturating_add(Q16::from_bits(
+                    t.drive
+                        .saturating_sub(self.drive_floor)
+                        .to_bits()
+                        .wrapping_shr(floor_shift), // ≤ 31: exact
+                ));
             }
         } else {
             self.step_ref = along;
             self.drive_ref = t.drive;
+            self.drive_floor = t.drive;
             self.step_ref_valid = true;
             self.guess_wait_ticks = if t.guessed { p.history_ticks } else { 0 };
         }
@@ -488,6 +508,21 @@ mod tests {
         let mut c = DriveChecks::default();
         run(&mut c, &before, 100);
         assert!(run(&mut c, &lost, 26).sensor_fault);
+    }
+
+    #[test]
+    fn the_quiet_spells_of_an_overrunning_chatter_are_no_lighter_step() {
+        // Tuning seed 4242, run 79848: the pack's engagement pulses the drive torque from 2 to
+        // 12 N·m every ≈ 46 ms. The history sits above the quiet spells, the floor at them.
+        // (Square pulses here, shorter than the persistence: the harder half stays out.)
+        let mut c = DriveChecks::default();
+        run(&mut c, &overrunning(2.0, false), 100);
+        for _ in 0..6 {
+            assert_eq!(run(&mut c, &overrunning(10.0, false), 20), Flags::default());
+            assert_eq!(run(&mut c, &overrunning(2.0, false), 95), Flags::default());
+        }
+        // The same spell with the reading at half its gain is below the floor.
+        assert!(run(&mut c, &overrunning(1.0, false), 26).sensor_fault);
     }
 
     /// `g₁ − 1`, the implied load's step per N·m of drive torque while overrunning.
