@@ -25,6 +25,15 @@ use crate::monitor::Flags;
 /// (16×: 0.4 s against 25.6 ms): a chatter's 10 N·m pulse of 20 ms lifts it ≤ 0.5 N·m.
 const FLOOR_RISE_SLOWER: u32 = 4;
 
+/// `state` moved towards `x` by `2^-shift` of the way (saturating difference; `shift` ≤ 31, so
+/// the shift is exact).
+#[inline]
+fn follow(state: Q16, x: Q16, shift: u32) -> Q16 {
+    state.saturating_add(Q16::from_bits(
+        x.saturating_sub(state).to_bits().wrapping_shr(shift),
+    ))
+}
+
 /// The drive checks' constants.
 #[cfg_attr(
     feature = "config-block",
@@ -287,23 +296,13 @@ impl DriveChecks {
                 // A shift for the gain (the power of two nearest the implied load's: 1/64, a
                 // 6.2 Hz corner against 5 Hz): the direction of a step needs no more, and it is
                 // cheaper than the multiply on the drive checks' tick, the drive's worst.
-                self.drive_ref = self.drive_ref.saturating_add(Q16::from_bits(
-                    t.drive
-                        .saturating_sub(self.drive_ref)
-                        .to_bits()
-                        .wrapping_shr(p.drive_ref_shift), // ≤ 30: exact
-                ));
+                self.drive_ref = follow(self.drive_ref, t.drive, p.drive_ref_shift);
                 let floor_shift = if t.drive > self.drive_floor {
                     p.drive_ref_shift.saturating_add(FLOOR_RISE_SLOWER).min(31)
                 } else {
                     p.drive_ref_shift
                 };
-                self.drive_floor = self.drive_floor.saturating_add(Q16::from_bits(
-                    t.drive
-                        .saturating_sub(self.drive_floor)
-                        .to_bits()
-                        .wrapping_shr(floor_shift), // ≤ 31: exact
-                ));
+                self.drive_floor = follow(self.drive_floor, t.drive, floor_shift);
             }
         } else {
             self.step_ref = along;
