@@ -202,6 +202,18 @@ fn continuous_closings_chatter_at_a_light_load_and_a_soft_servo_is_no_drag() {
     assert_quiet(&trace);
 }
 
+/// Tuning seed 1729's runs 5137 and 62115 (physical form, continuous closing at 7.1 and
+/// 8.4 N·m): the chatter's quiet spells sank the load estimate below the smallest load and the
+/// reading turned to driving; the pack's next pulse, against the drive's 6.6 and 7.0 N·m
+/// reference along the motion, read as a drag (`brake_drag` at 0.19 and 0.86 s).
+#[test]
+fn a_chatter_read_as_driving_on_an_aiding_reference_is_no_drag() {
+    for run in [5137, 62115] {
+        let (_, trace) = counted_draw(1729, run);
+        assert_quiet(&trace);
+    }
+}
+
 /// Tuning seed 7's run 9297 (physical form, reverse load): at power-on a seated contact sat at
 /// zero penetration within rounding, and its event fired at every step until the twin gave up
 /// ("events fire without time advancing"). A contact's event now fires at 1e-15 m.

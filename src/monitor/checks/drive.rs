@@ -322,9 +322,14 @@ impl DriveChecks {
         if t.carrying && !t.pending && self.drag_wait_ticks == 0 {
             let implied = t.net.saturating_add(t.dir.apply(p.drive_drag)); // load if drag nominal
             let over_model = implied.saturating_abs() > p.max_load;
-            let excess = t
-                .load_ref
-                .is_some_and(|r| t.dir.apply(r.saturating_sub(t.net)) > p.drag_limit);
+            // On a reference that aids the motion beyond the drag the output runs ahead and the
+            // ramps engage, moving the net torque through `J_s·ω̇` (continuous closing's
+            // chatter): there the drive itself must push past the allowance too.
+            let excess = t.load_ref.is_some_and(|r| {
+                t.dir.apply(r.saturating_sub(t.net)) > p.drag_limit
+                    && (t.dir.apply(r) <= p.drive_drag
+                        || t.drive > p.drag_limit.saturating_sub(p.drive_drag))
+            });
             self.drag_ticks = if over_model || excess {
                 self.drag_ticks.saturating_add(counted)
             } else {
@@ -428,8 +433,9 @@ mod tests {
 
     #[test]
     fn the_drag_check_waits_the_observers_settling_after_a_pending_change() {
-        // The pack torque 12 N·m beyond the load at the drive's start (limit: drag + 8 N·m).
-        let mut dragging = carrying(2.0, false);
+        // The pack torque 12 N·m beyond the load at the drive's start (limit: drag + 8 N·m),
+        // a 6 N·m load against the motion.
+        let mut dragging = carrying(20.0, false);
         dragging.load_ref = Some(dragging.net.saturating_add(Q16::from_num(12.0)));
         let pending = DriveTick {
             pending: true,
@@ -442,6 +448,33 @@ mod tests {
         // 20 ms of settling (50 runs), then 10 ms of persistence (25 runs).
         assert!(!run(&mut c, &dragging, 73).brake_drag);
         assert!(run(&mut c, &dragging, 1).brake_drag);
+    }
+
+    #[test]
+    fn a_pack_that_engages_on_a_reference_aiding_beyond_the_drag_is_no_drag() {
+        // Tuning seed 1729, run 5137: the chatter turned the reading to driving with the
+        // reference 6.6 N·m along the motion; the pack's next pulse took 18 N·m, the drive
+        // pushing 2.5 N·m.
+        let mut engaging = carrying(2.5, false);
+        engaging.net = Q16::from_num(-11.4);
+        engaging.load_ref = Some(Q16::from_num(6.6));
+        assert_eq!(
+            run(&mut DriveChecks::default(), &engaging, 100),
+            Flags::default()
+        );
+        // The same pack torque on a reference the drag carries (1.9 N·m along): a drag.
+        let dragging = DriveTick {
+            net: Q16::from_num(1.9 - 18.0),
+            load_ref: Some(Q16::from_num(1.9)),
+            ..engaging
+        };
+        assert!(run(&mut DriveChecks::default(), &dragging, 26).brake_drag);
+        // On the aiding reference with the drive pushing past the allowance (8 N·m): a drag.
+        let pushing = DriveTick {
+            drive: Q16::from_num(8.5),
+            ..engaging
+        };
+        assert!(run(&mut DriveChecks::default(), &pushing, 26).brake_drag);
     }
 
     #[test]
