@@ -8,12 +8,13 @@
 //! `cargo run --release -p host-tests --example commissioned_family -- [RUNS] [SEED] [PLAN]`
 //! (defaults 300, 4242, cycle).
 
-use host_tests::accuracy::{compare, run_monitor, scene_trace};
-use host_tests::commission::commission;
+use host_tests::accuracy::{compare, run_monitor};
+use host_tests::commission::{commission_unit, ACCEPTANCE};
 use host_tests::family::{form, runs_and_seed, Family};
-use host_tests::mc::{draw_in, draw_trace, not_driven};
+use host_tests::mc::{draw_in, draw_trace, mirror, not_driven};
 use noback::monitor::Config;
 use noback_twin::scene::SceneKind;
+use noback_twin::trace::Trace;
 use std::collections::BTreeMap;
 
 #[derive(Default)]
@@ -32,12 +33,10 @@ fn main() -> Result<(), String> {
     let mut args = std::env::args().skip(1);
     let (runs, seed) = runs_and_seed(&mut args, 300, 4242);
     // (kind, load) of each acceptance run.
-    let open = SceneKind::ReverseLoad;
-    let close = SceneKind::ForwardLoad;
     let plan: &[(SceneKind, f64)] = match args.next().as_deref() {
-        None | Some("cycle") => &[(open, 20.3), (open, 8.0), (close, 20.3)],
-        Some("two") => &[(open, 20.3), (open, 8.0)],
-        Some("one") => &[(open, 20.3)],
+        None | Some("cycle") => &ACCEPTANCE,
+        Some("two") => &ACCEPTANCE[..2],
+        Some("one") => &ACCEPTANCE[..1],
         Some(other) => return Err(format!("PLAN: `{other}`: expected one, two or cycle")),
     };
     let mut by: BTreeMap<String, Tally> = BTreeMap::new();
@@ -51,21 +50,20 @@ fn main() -> Result<(), String> {
         }
         let t = by.entry(form(&d.scene).to_string()).or_default();
         t.runs += 1;
-        let mut runs = Vec::new();
-        for &(kind, load) in plan {
-            let mut acceptance = d.scene.clone();
-            acceptance.kind = kind;
-            acceptance.load_torque_nm = load;
-            acceptance.initial_speed_rad_s = 13.78;
-            acceptance.release_at_s = Some(0.2);
-            acceptance.duration_s = 1.0;
-            acceptance.faults.clear();
-            runs.push((scene_trace(&acceptance)?, load));
-        }
         let uncommissioned = compare(&trace, &run_monitor(&trace, Config::default())?);
         t.fa_uncommissioned += usize::from(!uncommissioned.flags.is_empty());
-        let pairs: Vec<_> = runs.iter().map(|(t, l)| (t, *l)).collect();
-        let c = match commission(&pairs) {
+        let s = &d.scene.sensors;
+        let installed = |t: &mut Trace| {
+            if d.mirrored {
+                mirror(
+                    t,
+                    s.current_adc_bits,
+                    s.motor_counter_bits,
+                    s.output_encoder_bits,
+                );
+            }
+        };
+        let c = match commission_unit(&d.scene, plan, installed) {
             Ok(c) => c,
             Err(e) => {
                 t.refused += 1;

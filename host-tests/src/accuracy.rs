@@ -182,6 +182,26 @@ impl Accuracy {
         self.lock_time_s
             .map(|(twin, mon)| mon.map_or(f64::INFINITY, |m| (m - twin).abs()))
     }
+
+    /// The braking figures issue 16's accuracy targets name, when both end locked.
+    pub fn braking(&self) -> Option<Braking> {
+        Some(Braking {
+            holding_err_pct: self.holding_torque_err_pct()?,
+            force_rms_pct: self.pressing_force_rmse_pct,
+            lock_err_s: self.lock_time_err_s(),
+        })
+    }
+}
+
+/// A braking run's accuracy: holding torque, pressing force over the run, lock time.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Braking {
+    /// Holding-torque error (% of the twin's).
+    pub holding_err_pct: f64,
+    /// Pressing-force RMS error (% of the twin's compared peak).
+    pub force_rms_pct: f64,
+    /// Lock-time error (s; infinite when only the monitor misses the lock).
+    pub lock_err_s: Option<f64>,
 }
 
 /// First time after `from` at which `locked(i)` holds for [`LOCK_CONFIRM_S`].

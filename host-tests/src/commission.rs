@@ -2,7 +2,7 @@
 //! facts the uncommissioned monitor cannot know, identified from the unit's acceptance runs —
 //! each: the drive turns the door against (opening) or with (closing) a known load at a steady
 //! speed, is cut, and the brake holds the door; two opening runs at different loads also give
-//! the current's gain.
+//! the current's gain. The first run opens and sets the direction an opening turns the output.
 //!
 //! | identified | from | sets |
 //! |---|---|---|
@@ -16,10 +16,11 @@
 //! The pack's static capacity is not identified: it needs the brake made to slip (a functional
 //! test, issue 17); `capacity_mu` stays at Table 2's μ_s.
 
-use crate::accuracy::run_monitor;
+use crate::accuracy::{run_monitor, scene_trace};
 use noback::fx::{adc_centered, counter_delta};
 use noback::mechanism::Mechanism;
 use noback::monitor::{Config, DrivingPack, Thresholds};
+use noback_twin::scene::{Scene, SceneKind};
 use noback_twin::trace::Trace;
 
 /// Steady drive averaged before the cut (s), ending [`CUT_GUARD_S`] before it.
@@ -55,9 +56,10 @@ pub struct RunFigures {
     pub load_nm: f64,
     pub cut_s: f64,
     pub drive_speed_rad_s: f64,
-    /// Mean drive torque over the steady window (N·m, signed: negative against the load).
+    /// Mean drive torque over the steady window (N·m, signed as the current reads).
     pub drive_torque_nm: f64,
-    /// Whether the drive turned the output with the load (closing) rather than against it.
+    /// Whether the drive turned the output with the load (closing: the other way than the
+    /// first run, which opens) rather than against it.
     pub closing: bool,
     /// Mean current reading over the final hold, drive off (A).
     pub hold_current_a: f64,
@@ -112,8 +114,23 @@ fn hold_current_a(trace: &Trace, c: &Config) -> f64 {
     )
 }
 
+impl RunFigures {
+    /// The drive torque along the output's motion (N·m): the load and the drag opening, the
+    /// overrunning equilibrium's drive share closing.
+    pub fn along_nm(&self) -> f64 {
+        self.drive_torque_nm * self.drive_speed_rad_s.signum()
+    }
+}
+
 /// One run's figures, the monitor set with `base`; refuses a run that cannot give them.
-fn measure(trace: &Trace, load_nm: f64, base: Config) -> Result<RunFigures, String> {
+/// `opening`: the direction (±1) an opening turns the output, `None` for the first run, which
+/// opens and sets it (the sensors' mounting, not a convention, says which way that is).
+fn measure(
+    trace: &Trace,
+    load_nm: f64,
+    base: Config,
+    opening: Option<f64>,
+) -> Result<RunFigures, String> {
     if !(load_nm.is_finite() && load_nm >= base.thresholds.min_load_nm * 2.0) {
         return Err(format!(
             "the load {load_nm} N·m is below the {} N·m the identification needs",
@@ -202,14 +219,16 @@ fn measure(trace: &Trace, load_nm: f64, base: Config) -> Result<RunFigures, Stri
     let m: &Mechanism = &base.mechanism;
     // The pack's torque from the deceleration: J·|α| − M opening (the load helps stop the
     // output), J·|α| + M closing.
-    let opposed = m.output_inertia_kg_m2 * (speed.abs() / braking_time) + dir * load_nm;
+    let closing = opening.is_some_and(|o| dir != o);
+    let load_along = if closing { load_nm } else { -load_nm };
+    let opposed = m.output_inertia_kg_m2 * (speed.abs() / braking_time) + load_along;
     let capacity = m.pack_capacity_nm(m.quasi_static_pressing_force_n(load_nm), base.capacity_mu);
     Ok(RunFigures {
         load_nm,
         cut_s: cut as f64 * dt,
         drive_speed_rad_s: speed,
         drive_torque_nm: drive_torque,
-        closing: speed > 0.0,
+        closing,
         hold_current_a: hold_current_a(trace, &base),
         braking_time_s: braking_time,
         braking_nm: opposed,
@@ -233,18 +252,18 @@ pub fn commission(runs: &[(&Trace, f64)]) -> Result<Commissioning, String> {
     // The offset first (drive off in the hold, once the run checked out), so the drive torques
     // are read without it.
     let mut base = Config::default();
-    base.current_offset_a = measure(first.0, first.1, base)
-        .map_err(|e| name(0) + &e)?
-        .hold_current_a;
+    let first = measure(first.0, first.1, base, None).map_err(|e| name(0) + &e)?;
+    base.current_offset_a = first.hold_current_a;
+    let dir = Some(first.drive_speed_rad_s.signum());
     let figures = runs
         .iter()
         .enumerate()
-        .map(|(i, (t, load))| measure(t, *load, base).map_err(|e| name(i) + &e))
+        .map(|(i, (t, load))| {
+            measure(t, *load, base, dir.filter(|_| i > 0)).map_err(|e| name(i) + &e)
+        })
         .collect::<Result<Vec<_>, _>>()?;
+    // The first run opens: never empty.
     let opening: Vec<&RunFigures> = figures.iter().filter(|f| !f.closing).collect();
-    if opening.is_empty() {
-        return Err("no run opens against the load: the drag and the form need one".into());
-    }
     // Drive torque against the load: −D̂ = g·(M + drag), one line through the opening runs.
     let (lo, hi) = opening
         .iter()
@@ -253,10 +272,10 @@ pub fn commission(runs: &[(&Trace, f64)]) -> Result<Commissioning, String> {
         });
     let gain = if hi - lo >= MIN_LOAD_SPAN_NM {
         let lm = mean(opening.iter().map(|f| f.load_nm));
-        let dm = mean(opening.iter().map(|f| -f.drive_torque_nm));
+        let dm = mean(opening.iter().map(|f| f.along_nm()));
         let sxy: f64 = opening
             .iter()
-            .map(|f| (f.load_nm - lm) * (-f.drive_torque_nm - dm))
+            .map(|f| (f.load_nm - lm) * (f.along_nm() - dm))
             .sum();
         let sxx: f64 = opening.iter().map(|f| (f.load_nm - lm).powi(2)).sum();
         sxy / sxx
@@ -272,15 +291,11 @@ pub fn commission(runs: &[(&Trace, f64)]) -> Result<Commissioning, String> {
             "the drive torque grows {gain:.3} times the load: not a healthy drive (are the loads right?)"
         ));
     }
-    let drag = mean(
-        opening
-            .iter()
-            .map(|f| -f.drive_torque_nm / gain - f.load_nm),
-    );
+    let drag = mean(opening.iter().map(|f| f.along_nm() / gain - f.load_nm));
     if drag <= 0.0 {
         return Err(format!(
-            "the drive took {:.3} N·m against a load of {} N·m: no drag left for the pack (is the load right?)",
-            -opening[0].drive_torque_nm, opening[0].load_nm
+            "the drive took {:.3} N·m against a load of {} N·m: no drag left for the pack (is the load right, and does the first run open against it?)",
+            opening[0].along_nm(), opening[0].load_nm
         ));
     }
     let heaviest = opening
@@ -295,7 +310,7 @@ pub fn commission(runs: &[(&Trace, f64)]) -> Result<Commissioning, String> {
     let closing = figures.iter().find(|f| f.closing);
     let a = match (relieved, closing) {
         (true, Some(f)) => {
-            let v = f.drive_torque_nm / gain;
+            let v = f.along_nm() / gain;
             let y = f.load_nm + v;
             let den = y * k - 2.0 * k * v + spring;
             if !(v > 0.0 && den > 0.0) {
@@ -362,4 +377,45 @@ fn configured(base: Config, a: f64, share: f64, relieved: bool) -> Config {
         0.0
     };
     cfg
+}
+
+/// The documented acceptance procedure (docs/commissioning.md), as `(kind, load N·m)`: two
+/// openings against the door's load and a test weight 12 N·m apart, and one closing with it;
+/// each at [`ACCEPTANCE_SPEED_RAD_S`], cut at [`ACCEPTANCE_CUT_S`], run for
+/// [`ACCEPTANCE_RUN_S`].
+pub const ACCEPTANCE: [(SceneKind, f64); 3] = [
+    (SceneKind::ReverseLoad, 20.3),
+    (SceneKind::ReverseLoad, 8.0),
+    (SceneKind::ForwardLoad, 20.3),
+];
+/// The acceptance runs' steady input speed (rad/s): Table 2's opening speed.
+pub const ACCEPTANCE_SPEED_RAD_S: f64 = 13.78;
+/// The acceptance runs' drive cut (s): [`MIN_DRIVE_S`] of steady drive.
+pub const ACCEPTANCE_CUT_S: f64 = 0.2;
+/// The acceptance runs' length (s): the cut, the braking and a hold well past [`MIN_HOLD_S`].
+pub const ACCEPTANCE_RUN_S: f64 = 1.0;
+
+/// The unit `scene` runs on (its plant, sensors and noise; its faults left out: acceptance
+/// finds it healthy) taken through the acceptance `plan` (as [`ACCEPTANCE`]) on the twin, each
+/// trace passed through `installed` (how the unit's sensors are mounted), and commissioned.
+pub fn commission_unit(
+    scene: &Scene,
+    plan: &[(SceneKind, f64)],
+    installed: impl Fn(&mut Trace),
+) -> Result<Commissioning, String> {
+    let mut traces = Vec::new();
+    for &(kind, load) in plan {
+        let mut run = scene.clone();
+        run.kind = kind;
+        run.load_torque_nm = load;
+        run.initial_speed_rad_s = ACCEPTANCE_SPEED_RAD_S;
+        run.release_at_s = Some(ACCEPTANCE_CUT_S);
+        run.duration_s = ACCEPTANCE_RUN_S;
+        run.faults.clear();
+        let mut trace = scene_trace(&run)?;
+        installed(&mut trace);
+        traces.push((trace, load));
+    }
+    let runs: Vec<_> = traces.iter().map(|(t, l)| (t, *l)).collect();
+    commission(&runs)
 }

@@ -14,10 +14,8 @@
 //! manifests ([`crate::accuracy::manifest_time`]). A nominal run with any flag is a false
 //! alarm. Runs are spread over the machine's cores.
 
-use crate::accuracy::{
-    compare, detection_latency_s, manifest_time, run_monitor, run_monitor_with, scene_trace,
-};
-use crate::dormant::{functional_test_after, Verdict};
+use crate::accuracy::scene_trace;
+use crate::dormant::Verdict;
 use crate::family::Family;
 use noback::fx::counter_delta;
 use noback::mechanism::Mechanism;
@@ -28,8 +26,6 @@ use noback_twin::reading::Reading;
 use noback_twin::scene::{Scene, SceneKind};
 use noback_twin::sensing::Rng;
 use noback_twin::trace::Trace;
-use std::sync::atomic::{AtomicUsize, Ordering};
-use std::sync::Mutex;
 
 /// A fault counts as detected if flagged within this long after it manifests (s).
 pub const DETECTION_WINDOW_S: f64 = 0.050;
@@ -82,6 +78,10 @@ pub struct Outcome {
     pub test: Option<Verdict>,
     /// `brake_degraded` rose after the fault's onset: the drive's own cycle found the fault.
     pub warned: bool,
+    /// A commissioned campaign's acceptance refused the unit: it ran uncommissioned.
+    pub refused: bool,
+    /// A nominal braking run's accuracy (reverse_load, forward_load; not kept in part files).
+    pub braking: Option<crate::accuracy::Braking>,
 }
 
 impl Outcome {
@@ -99,6 +99,8 @@ impl Outcome {
             not_driven: false,
             test: None,
             warned: false,
+            refused: false,
+            braking: None,
         }
     }
 
@@ -383,127 +385,5 @@ pub fn draw_trace_after(d: &Draw, pre_roll_s: f64) -> Result<Trace, String> {
     Ok(trace)
 }
 
-/// What a campaign runs the draws with: the monitor's configuration and the pre-roll (the
-/// defaults are the shipped monitor and [`PRE_ROLL_S`]; others serve the ablations in
-/// docs/decisions.md, `cargo xtask monitor-mc --power-on-settle S --pre-roll S`).
-#[derive(Clone, Copy, Debug)]
-pub struct Campaign {
-    /// The monitor's configuration.
-    pub config: Config,
-    /// How long the twin runs before the monitor is powered on (s).
-    pub pre_roll_s: f64,
-    /// The functional test also runs after one nominal run in this many (by the run's noise
-    /// seed; 0: none) — and after every fault run whose fault stayed dormant (unless 0).
-    pub test_every: u64,
-}
-
-impl Campaign {
-    /// The campaign of a plant family, with the monitor [`Family::config`] gives it.
-    pub fn for_family(family: Family) -> Campaign {
-        Campaign {
-            config: family.config(),
-            pre_roll_s: PRE_ROLL_S,
-            test_every: TEST_EVERY,
-        }
-    }
-}
-
-impl Default for Campaign {
-    /// The default family's campaign.
-    fn default() -> Self {
-        Campaign::for_family(Family::PhysicalDefault)
-    }
-}
-
-/// The share of nominal runs the functional test follows by default (one in this many).
-pub const TEST_EVERY: u64 = 10;
-
-/// Runs one draw through the twin and the monitor, then the functional test if it is due.
-pub fn evaluate(d: &Draw, campaign: &Campaign) -> Outcome {
-    let fault = d.scene.faults.first().copied();
-    let fail = |e: String| Outcome {
-        error: Some(e),
-        ..Outcome::quiet(fault.map(|f| f.kind))
-    };
-    let trace = match draw_trace_after(d, campaign.pre_roll_s) {
-        Ok(trace) => trace,
-        Err(e) => return fail(e),
-    };
-    // The monitor is configured with the nominal Table 2, not the drawn mechanism: it must
-    // cope with a ±10 % real part.
-    let estimates = match run_monitor(&trace, campaign.config) {
-        Ok(e) => e,
-        Err(e) => return fail(e),
-    };
-    let acc = compare(&trace, &estimates);
-    let with_command = match run_monitor_with(&trace, campaign.config, true) {
-        Ok(e) => compare(&trace, &e),
-        Err(e) => return fail(e),
-    };
-    let onset = fault.map_or(f64::INFINITY, |f| f.at_s);
-    let manifested = fault.is_some_and(|f| manifest_time(&f, &trace).is_some());
-    let not_driven = fault.is_none() && not_driven(&trace, &d.scene.sensors);
-    let every = campaign.test_every;
-    let tested = every > 0
-        && match fault {
-            Some(_) => !manifested,
-            None => !not_driven && d.scene.noise.seed.is_multiple_of(every),
-        };
-    let test = if tested {
-        match functional_test_after(d, campaign.config) {
-            Ok(v) => v,
-            Err(e) => return fail(e),
-        }
-    } else {
-        None
-    };
-    Outcome {
-        fault: fault.map(|f| f.kind),
-        latency_s: fault.and_then(|f| detection_latency_s(&f, &trace, &acc)),
-        latency_with_command_s: fault.and_then(|f| detection_latency_s(&f, &trace, &with_command)),
-        manifested,
-        context: fault.map(|f| Context::of(f.at_s, &trace, d.scene.kind, &campaign.config)),
-        false_flags: acc.flags.iter().filter(|f| f.t_s < onset).count(),
-        false_flags_with_command: with_command.flags.iter().filter(|f| f.t_s < onset).count(),
-        error: None,
-        not_driven,
-        test,
-        warned: fault.is_some()
-            && acc
-                .flags
-                .iter()
-                .any(|f| f.flag == "brake_degraded" && f.t_s >= onset),
-    }
-}
-
-/// Runs every draw on `threads` workers, calling `progress(done, total)` as runs finish.
-pub fn run_all(
-    draws: &[Draw],
-    campaign: &Campaign,
-    threads: usize,
-    progress: &(dyn Fn(usize, usize) + Sync),
-) -> Vec<Outcome> {
-    let next = AtomicUsize::new(0);
-    let results = Mutex::new(vec![None; draws.len()]);
-    std::thread::scope(|scope| {
-        for _ in 0..threads.max(1) {
-            scope.spawn(|| loop {
-                let i = next.fetch_add(1, Ordering::Relaxed);
-                let Some(d) = draws.get(i) else { break };
-                let outcome = evaluate(d, campaign);
-                let done = {
-                    let mut r = results.lock().unwrap_or_else(|p| p.into_inner());
-                    r[i] = Some(outcome);
-                    r.iter().filter(|o| o.is_some()).count()
-                };
-                progress(done, draws.len());
-            });
-        }
-    });
-    results
-        .into_inner()
-        .unwrap_or_else(|p| p.into_inner())
-        .into_iter()
-        .flatten()
-        .collect()
-}
+mod run;
+pub use run::{commission_draw, evaluate, run_all, Campaign, TEST_EVERY};

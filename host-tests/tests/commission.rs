@@ -3,7 +3,8 @@
 //! noise seeds, and on closing runs.
 
 use host_tests::accuracy::{compare, run_monitor, scene_trace};
-use host_tests::commission::commission;
+use host_tests::commission::{commission, commission_unit, ACCEPTANCE};
+use host_tests::mc::mirror;
 use noback::monitor::{Config, DrivingPack};
 use noback_twin::reading::Reading;
 use noback_twin::scene::{Scene, SceneKind};
@@ -137,4 +138,52 @@ fn a_run_with_the_wrong_load_is_refused_or_misread_openly() {
     // Two runs must span enough load to give the gain.
     let e = commission(&[(&t, 20.3), (&t, 21.0)]).unwrap_err();
     assert!(e.contains("span"), "{e}");
+}
+
+/// A unit mounted the other way (every reading negated, `mc::mirror`) opens in the positive
+/// direction: its first run says so, and it is set as its twin mounted the usual way, the
+/// current's offset negated. The unit's own forward_load then holds within 2 % as well.
+#[test]
+fn a_unit_mounted_the_other_way_is_set_alike() {
+    let s = Scene::builtin(SceneKind::ReverseLoad, Reading::Physical).sensors;
+    let negate = |t: &mut Trace| {
+        mirror(
+            t,
+            s.current_adc_bits,
+            s.motor_counter_bits,
+            s.output_encoder_bits,
+        )
+    };
+    let mut unit = scene(
+        SceneKind::ReverseLoad,
+        Reading::Physical,
+        20.3,
+        13.78,
+        (4, 0.02),
+    );
+    unit.noise.current_offset_a = 0.15;
+    let usual = commission_unit(&unit, &ACCEPTANCE, |_| {}).unwrap();
+    let other = commission_unit(&unit, &ACCEPTANCE, negate).unwrap();
+    assert!(other.runs[0].drive_speed_rad_s > 0.0 && other.runs[2].closing);
+    assert_eq!(
+        (other.gain, other.drive_drag_nm, other.braking_share),
+        (usual.gain, usual.drive_drag_nm, usual.braking_share)
+    );
+    assert_eq!(other.current_offset_a, -usual.current_offset_a);
+    assert_eq!(other.config.driving_pack, usual.config.driving_pack);
+    let mut closing = scene(
+        SceneKind::ForwardLoad,
+        Reading::Physical,
+        15.0,
+        10.0,
+        (8, 0.02),
+    );
+    closing.noise.current_offset_a = 0.15;
+    let mut trace = scene_trace(&closing).unwrap();
+    negate(&mut trace);
+    let err = holds_within_2pct(&trace, other.config, "mounted the other way, forward_load");
+    println!(
+        "mounted the other way: offset {:.3} A, forward_load holding error {err:.2} %",
+        other.current_offset_a
+    );
 }

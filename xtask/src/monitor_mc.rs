@@ -3,6 +3,7 @@
 //! (`--shard K/N --out part-K.json`) and merged (`monitor-mc merge part-*.json`) with the same
 //! bytes as the whole; `slurm/` runs the shards as a job array.
 
+mod family_page;
 mod page;
 mod part;
 mod report;
@@ -35,6 +36,9 @@ enum Command {
     Merge(MergeArgs),
     /// Runs per second per core; writes the benchmark page docs/results/mc-throughput.md.
     Throughput(throughput::ThroughputArgs),
+    /// The plant family at a tuning and an evaluation seed, uncommissioned and commissioned,
+    /// per form; writes docs/monitor-family.md.
+    Family(family_page::FamilyArgs),
 }
 
 #[derive(Args, Debug)]
@@ -88,6 +92,11 @@ struct RunArgs {
     /// docs/model.md), reported per form; the page is written for the default family only.
     #[arg(long, value_parser = family, default_value = "physical-default", value_name = "physical-default|plant")]
     family: Family,
+    /// Commission each draw's unit on the acceptance procedure of its healthy plant
+    /// (docs/commissioning.md) and run it on that configuration (uncommissioned where
+    /// acceptance refuses it, counted); the page is not written.
+    #[arg(long)]
+    commissioned: bool,
 }
 
 fn family(v: &str) -> Result<Family, String> {
@@ -162,6 +171,7 @@ pub fn main(args: &[String]) -> Result<i32, String> {
     let result = match cli.command {
         Some(Command::Merge(m)) => merge_main(&m),
         Some(Command::Throughput(t)) => throughput::main(&t).map_err(Fail::Run),
+        Some(Command::Family(f)) => family_page::main(&f).map_err(Fail::Run),
         None => run_main(&cli.run),
     };
     match result {
@@ -257,6 +267,7 @@ fn campaign_of(setup: &Setup, family: Family, seed: u64, runs: u64, fault_runs: 
         runs,
         fault_runs,
         test_every: setup.test_every,
+        commissioned: setup.commissioned,
     }
 }
 
@@ -271,6 +282,7 @@ fn run_main(a: &RunArgs) -> Result<(), Fail> {
     if let Some(k) = a.test_every {
         setup.test_every = k;
     }
+    setup.commissioned = a.commissioned;
     noback::monitor::Monitor::new(setup.config)
         .map_err(|e| Fail::Input(format!("monitor configuration: {e:?}")))?;
     let mut campaign = campaign_of(&setup, a.family, a.seed, a.runs, a.fault_runs);
@@ -292,6 +304,7 @@ fn run_main(a: &RunArgs) -> Result<(), Fail> {
     let ablation = setup.config != shipped.config
         || setup.pre_roll_s != shipped.pre_roll_s
         || a.legacy_draws
+        || a.commissioned
         || a.family != Family::PhysicalDefault;
     // Through the part's text, as a merge reads it: the same bytes whichever way.
     let part = serde_json::from_str(&text).map_err(|e| e.to_string())?;
@@ -319,6 +332,7 @@ fn merge_main(m: &MergeArgs) -> Result<(), Fail> {
     if let Some((name, p)) = parts.first() {
         setup.pre_roll_s = p.campaign.pre_roll_s;
         setup.config.thresholds.power_on_settle_s = p.campaign.power_on_settle_s;
+        setup.commissioned = p.campaign.commissioned;
         let digest = part::config_digest(&setup.config);
         if p.campaign.config_digest != digest {
             return Err(Fail::Input(format!(
@@ -331,8 +345,10 @@ fn merge_main(m: &MergeArgs) -> Result<(), Fail> {
     let other_family = parts
         .first()
         .is_some_and(|(_, p)| p.campaign.plant_family != Family::PhysicalDefault.name());
-    let ablation =
-        setup.config != shipped.config || setup.pre_roll_s != shipped.pre_roll_s || other_family;
+    let ablation = setup.config != shipped.config
+        || setup.pre_roll_s != shipped.pre_roll_s
+        || setup.commissioned
+        || other_family;
     finish(
         &parts,
         m.prefix,
@@ -406,10 +422,11 @@ pub fn report_of(
         config_digest: campaign.config_digest.clone(),
         config: setup.config,
         pre_roll_s: campaign.pre_roll_s,
+        commissioned: campaign.commissioned,
     };
     let mut report = report::build(&meta, outcomes)?;
     if campaign.plant_family == Family::Plant.name() {
-        report["by_form"] = report::by_form(outcomes, &forms_of(campaign));
+        report["by_form"] = report::by_form(outcomes, &forms_of(campaign), campaign.commissioned);
     }
     let record_path = workspace_root().join(page::CAMPAIGN_RECORD);
     let record = match std::fs::read_to_string(&record_path) {

@@ -132,6 +132,7 @@ fn bad_values_are_refused_naming_them() {
         (&["monitor-mc", "--seed", "abc"], "abc"),
         (&["monitor-mc", "--pre-roll", "inf"], "inf"),
         (&["monitor-mc", "--shard", "3/2", "--out", "p.json"], "3/2"),
+        (&["monitor-mc", "family", "--runs", "-1"], "-1"),
     ];
     for (args, named) in cases {
         refused(args, named);
@@ -143,6 +144,7 @@ fn an_extra_positional_is_refused() {
     let cases: &[(&[&str], &str)] = &[
         (&["monitor", "hold", "forward_load"], "forward_load"),
         (&["monitor-mc", "extra"], "extra"),
+        (&["monitor-mc", "family", "extra"], "extra"),
         (&["twin", "hold", "drive"], "drive"),
         (&["run", "hold"], "hold"),
         (&["paper", "extra"], "extra"),

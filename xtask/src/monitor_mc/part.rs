@@ -28,6 +28,9 @@ pub struct Campaign {
     /// The functional test's share of nominal runs (`host_tests::mc::Campaign::test_every`).
     #[serde(default)]
     pub test_every: u64,
+    /// Each draw's unit commissioned on its acceptance runs (`--commissioned`).
+    #[serde(default)]
+    pub commissioned: bool,
 }
 
 /// One fault run's outcome.
@@ -51,6 +54,9 @@ pub struct FaultRun {
     /// `brake_degraded` rose after the onset.
     #[serde(default)]
     pub warned: bool,
+    /// Acceptance refused the unit (a commissioned campaign): it ran uncommissioned.
+    #[serde(default)]
+    pub refused: bool,
 }
 
 /// A nominal run the twin could not run.
@@ -79,6 +85,9 @@ pub struct Part {
     /// Nominal runs whose plant did not move its output while driven (`mc::not_driven`).
     #[serde(default)]
     pub not_driven_runs: Vec<u64>,
+    /// Nominal runs whose unit acceptance refused (a commissioned campaign).
+    #[serde(default)]
+    pub refused_runs: Vec<u64>,
     pub nominal_errors: Vec<RunError>,
     /// The nominal runs the functional test followed, each `(index, verdict)`.
     #[serde(default)]
@@ -158,6 +167,7 @@ impl Part {
                 o.counts_as_nominal() && o.false_flags_with_command > 0
             }),
             not_driven_runs: nominal_where(|o| o.error.is_none() && o.not_driven),
+            refused_runs: nominal_where(|o| o.refused),
             nominal_errors: nominal
                 .clone()
                 .zip(nom)
@@ -184,6 +194,7 @@ impl Part {
                     error: o.error.clone(),
                     test: o.test.map(|v| verdict_tag(v).into()),
                     warned: o.warned,
+                    refused: o.refused,
                 })
                 .collect(),
         }
@@ -217,6 +228,8 @@ fn outcome_of(r: &FaultRun) -> Result<Outcome, String> {
         not_driven: false,
         test: r.test.as_deref().map(verdict_of).transpose()?,
         warned: r.warned,
+        refused: r.refused,
+        braking: None,
     })
 }
 
@@ -299,6 +312,13 @@ fn check(name: &str, p: &Part, first: &(String, Campaign)) -> Result<(), String>
             f.pre_roll_s.to_string(),
         );
     }
+    if c.commissioned != f.commissioned {
+        return differs(
+            "commissioning",
+            c.commissioned.to_string(),
+            f.commissioned.to_string(),
+        );
+    }
     if c.test_every != f.test_every {
         return differs(
             "functional-test share",
@@ -316,6 +336,7 @@ fn check(name: &str, p: &Part, first: &(String, Campaign)) -> Result<(), String>
     let in_nominal = |i: &u64| (p.nominal[0]..p.nominal[1]).contains(i);
     if !p.false_alarm_runs.iter().all(in_nominal)
         || !p.not_driven_runs.iter().all(in_nominal)
+        || !p.refused_runs.iter().all(in_nominal)
         || !p.nominal_errors.iter().all(|e| in_nominal(&e.index))
         || !p.nominal_tests.iter().all(|(i, _)| in_nominal(i))
     {
@@ -362,6 +383,9 @@ pub fn merge(parts: &[(String, Part)], prefix: bool) -> Result<(Campaign, Vec<Ou
         }
         for &i in &p.not_driven_runs {
             nominal[i as usize].not_driven = true;
+        }
+        for &i in &p.refused_runs {
+            nominal[i as usize].refused = true;
         }
         for e in &p.nominal_errors {
             nominal[e.index as usize].error = Some(e.error.clone());

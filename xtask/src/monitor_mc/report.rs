@@ -31,6 +31,8 @@ pub struct Meta {
     pub config_digest: String,
     pub config: Config,
     pub pre_roll_s: f64,
+    /// Each draw's unit commissioned on its acceptance runs.
+    pub commissioned: bool,
 }
 
 /// `k` of `n` as `{"rate", "ci95": [lo, hi], "of": [k, n]}` (rate and bounds null when `n` = 0).
@@ -147,7 +149,7 @@ pub fn build(meta: &Meta, outcomes: &[Outcome]) -> Result<Value, String> {
             "false_alarms_before_onset": runs.iter().filter(|o| o.false_flags > 0).count(),
         }));
     }
-    Ok(json!({
+    let mut report = json!({
         "seed": meta.seed,
         "runs": meta.runs,
         "fault_runs": meta.fault_runs,
@@ -169,7 +171,11 @@ pub fn build(meta: &Meta, outcomes: &[Outcome]) -> Result<Value, String> {
         "not_driven_runs": not_driven,
         "paper_scenes": paper_scenes()?,
         "targets_met": all_ok,
-    }))
+    });
+    if meta.commissioned {
+        report["commissioning_refused_runs"] = json!(outcomes.iter().filter(|o| o.refused).count());
+    }
+    Ok(report)
 }
 
 /// The functional tests after nominal runs: tested in service, failed (a false fail), and
@@ -223,8 +229,9 @@ pub fn context_name(c: Context) -> &'static str {
 pub const FORMS: [&str; 2] = ["paper", "physical"];
 
 /// Per plant form: its nominal runs' false-alarm rate and each fault kind's detection among
-/// its manifested runs, with their intervals. `forms` is aligned with `outcomes`.
-pub fn by_form(outcomes: &[Outcome], forms: &[&str]) -> Value {
+/// its manifested runs, with their intervals. `forms` is aligned with `outcomes`. A
+/// `commissioned` campaign also counts the units acceptance refused.
+pub fn by_form(outcomes: &[Outcome], forms: &[&str], commissioned: bool) -> Value {
     let mut out = serde_json::Map::new();
     for form in FORMS {
         let mine: Vec<&Outcome> = outcomes
@@ -244,15 +251,16 @@ pub fn by_form(outcomes: &[Outcome], forms: &[&str]) -> Value {
             let hits = manifested.iter().filter(|o| detected(o)).count();
             detection.insert(format!("{kind:?}"), rate(hits, manifested.len()));
         }
-        out.insert(
-            form.into(),
-            json!({
-                "false_alarm": rate(false_alarms, nominal.len()),
-                "errors": mine.iter().filter(|o| o.error.is_some()).count(),
-                "not_driven": mine.iter().filter(|o| o.not_driven).count(),
-                "detection": detection,
-            }),
-        );
+        let mut v = json!({
+            "false_alarm": rate(false_alarms, nominal.len()),
+            "errors": mine.iter().filter(|o| o.error.is_some()).count(),
+            "not_driven": mine.iter().filter(|o| o.not_driven).count(),
+            "detection": detection,
+        });
+        if commissioned {
+            v["commissioning_refused"] = json!(mine.iter().filter(|o| o.refused).count());
+        }
+        out.insert(form.into(), v);
     }
     Value::Object(out)
 }
@@ -273,6 +281,11 @@ pub fn form_table(forms: &serde_json::Map<String, Value>) -> String {
             v["errors"],
             v["not_driven"]
         ));
+        if let Some(n) = v.get("commissioning_refused") {
+            text.push_str(&format!(
+                "    commissioning refused {n} (run uncommissioned)\n"
+            ));
+        }
         if let Some(d) = v["detection"].as_object() {
             for (kind, r) in d {
                 let lo = r["ci95"][0]

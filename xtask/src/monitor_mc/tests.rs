@@ -81,6 +81,31 @@ fn a_plant_family_campaign_reports_each_form_and_merges_exactly() {
         .is_none());
 }
 
+/// Every unit commissioned on its own acceptance runs: the shards still merge exactly, each
+/// form counts the units acceptance refused, and the runs differ from uncommissioned ones only
+/// where the configuration does.
+#[test]
+fn a_commissioned_campaign_counts_refusals_and_merges_exactly() {
+    let mut setup = Setup::for_family(Family::Plant);
+    setup.commissioned = true;
+    let c = campaign_of(&setup, Family::Plant, 11, 8, 1);
+    assert!(c.commissioned);
+    let whole = through_text(&run_part(&setup, c.clone(), 0, 1, 2));
+    let (json, _) = report(&[("whole".into(), whole)]);
+    let forms = json["by_form"].as_object().expect("per form");
+    assert!(forms
+        .values()
+        .all(|f| f["commissioning_refused"].as_u64().is_some()));
+    assert!(json["commissioning_refused_runs"].as_u64().is_some());
+    let parts: Vec<(String, Part)> = (0..2)
+        .map(|k| {
+            let p = run_part(&setup, c.clone(), k, 2, 1);
+            (format!("part-{k}"), through_text(&p))
+        })
+        .collect();
+    assert_eq!(report(&parts).0.to_string(), json.to_string());
+}
+
 #[test]
 fn merge_refuses_parts_that_do_not_belong_together() {
     let (setup, c) = campaign();
@@ -119,6 +144,15 @@ fn merge_refuses_parts_that_do_not_belong_together() {
             ("d".into(), empty(&family, 4..RUNS, 1..FAULT_RUNS)),
         ],
         "d: plant family",
+    );
+    let mut commissioned = c.clone();
+    commissioned.commissioned = true;
+    refused(
+        &[
+            ("a".into(), a.clone()),
+            ("h".into(), empty(&commissioned, 4..RUNS, 1..FAULT_RUNS)),
+        ],
+        "h: commissioning",
     );
     let mut digest = c.clone();
     digest.config_digest = part::config_digest(&{
