@@ -7,9 +7,7 @@
 //! let mut monitor = Monitor::new(Config::default()).unwrap();
 //! // Drive off, no current (ADC mid-scale), both encoders at rest.
 //! let mut estimate = monitor.step(&Inputs::new(2048, 0, 0, false));
-//! for _ in 0..200 {
-//!     estimate = monitor.step(&Inputs::new(2048, 0, 0, false));
-//! }
+//! for _ in 0..200 { estimate = monitor.step(&Inputs::new(2048, 0, 0, false)); }
 //! assert_eq!(estimate.brake, noback::monitor::BrakeState::Locked);
 //! assert!(!estimate.flags.any());
 //! ```
@@ -35,7 +33,8 @@
 //! from the motor current, `M` the load and `T` the pack torque (Table 1, `pack`). The axial
 //! balance is quasi-static (the twin's physical reading). A three-state observer on the output
 //! encoder tracks `J_s·ω̇ − u` with the model's `T̂` fed forward. The load is learned only while
-//! driving, where the pack torque follows from the current alone, and held with the drive off.
+//! driving, where the pack torque follows from the current alone, and held with the drive off;
+//! a spring-only pack hides a load that aids the motion (it overruns on almost no drive torque).
 //!
 //! # Formats
 //! | quantity | format | range | resolution |
@@ -410,7 +409,8 @@ impl State {
             // The load a pack torque implies; on a guess, the driving reading's beside it.
             let implied = |t: Q16| o.net.saturating_add(c.dir.apply(t));
             let other = c.guessed.then(|| implied(k.pack.drive_drag));
-            self.load.learn(&k.load, implied(pack), other, x.n);
+            let unseen = k.pack.spring_only && c.dir.apply(implied(pack)) > Q16::ZERO;
+            self.load.learn(&k.load, implied(pack), other, unseen, x.n);
         }
         let load = self.load.estimate.value();
         // The cache follows a changing load once per window while driving (never on a drive
@@ -506,7 +506,7 @@ impl State {
         let e = &mut self.estimate;
         e.tick = self.tick;
         e.trusted = commissioned
-            && self.load.decided()
+            && self.load.trusted()
             && o.settled
             && o.sensors_ok
             && o.in_time

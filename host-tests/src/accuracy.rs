@@ -158,6 +158,8 @@ pub struct Accuracy {
     pub braking_torque_rmse_nm: f64,
     /// Holding torque: twin, monitor (N·m), if both end locked.
     pub holding_torque_nm: Option<(f64, f64)>,
+    /// The monitor's last estimate is marked trusted.
+    pub trusted_at_end: bool,
     /// Lock time after the drive cut: twin, monitor (s), if both lock.
     pub lock_time_s: Option<(f64, Option<f64>)>,
     /// Flags as they were raised.
@@ -189,6 +191,7 @@ impl Accuracy {
             holding_err_pct: self.holding_torque_err_pct()?,
             force_rms_pct: self.pressing_force_rmse_pct,
             lock_err_s: self.lock_time_err_s(),
+            trusted: self.trusted_at_end,
         })
     }
 }
@@ -202,6 +205,8 @@ pub struct Braking {
     pub force_rms_pct: f64,
     /// Lock-time error (s; infinite when only the monitor misses the lock).
     pub lock_err_s: Option<f64>,
+    /// The monitor marked its estimate trusted at the end of the run.
+    pub trusted: bool,
 }
 
 /// First time after `from` at which `locked(i)` holds for [`LOCK_CONFIRM_S`].
@@ -293,6 +298,7 @@ pub fn compare(trace: &Trace, estimates: &[Estimate]) -> Accuracy {
         pressing_force_rmse_pct: 100.0 * pressing_force_rmse_n / peak,
         braking_torque_rmse_nm,
         holding_torque_nm,
+        trusted_at_end: n > 0 && estimates[n - 1].trusted,
         lock_time_s,
         flags,
     }

@@ -152,6 +152,9 @@ pub(crate) struct Load {
     /// The driving reading's load, learned beside the estimate while the overrunning reading
     /// is a power-on guess (`Classified::guessed`): the estimate's sign is not known.
     pub alt: Option<Q16>,
+    /// Last learned aiding the motion of a spring-only pack, which overruns on almost no drive
+    /// torque whatever the load: the load is not seen, and no estimate on it is trusted.
+    pub unseen: bool,
 }
 
 impl Load {
@@ -174,6 +177,7 @@ impl Load {
                 available: Q16::ZERO,
             },
             alt: None,
+            unseen: false,
         }
     }
 
@@ -193,7 +197,16 @@ impl Load {
 
     /// One slow-lane learning step with the load this call implies (`n` ticks elapsed) and, on
     /// a guessed reading, the other reading's; learning on a decided reading drops `alt`.
-    pub fn learn(&mut self, k: &LoadSettings, implied: Q16, other: Option<Q16>, n: u32) {
+    /// `unseen`: the reading does not show the load (see [`Load::unseen`]).
+    pub fn learn(
+        &mut self,
+        k: &LoadSettings,
+        implied: Q16,
+        other: Option<Q16>,
+        unseen: bool,
+        n: u32,
+    ) {
+        self.unseen = unseen;
         self.alt = other.map(|y| lowpass(self.alt.unwrap_or(self.estimate.value()), y, k.alpha));
         let value = lowpass(self.estimate.value(), implied, k.alpha);
         self.learn_ticks = self.learn_ticks.saturating_add(SLOW.covered(n));
@@ -231,6 +244,11 @@ impl Load {
     /// pack-health learning count on.
     pub fn decided(&self) -> bool {
         self.estimate.known().is_some() && self.alt.is_none()
+    }
+
+    /// [`Load::decided`] and seen: what an estimate resting on the load may be trusted on.
+    pub fn trusted(&self) -> bool {
+        self.decided() && !self.unseen
     }
 
     /// Whether the cache was formed for another load.
@@ -276,7 +294,7 @@ mod tests {
         let mut load = Load::new();
         // Learned under the overrunning reading (one call per slow-lane slot): 60 N·m, not known.
         for _ in 0..k.known_ticks / SLOW.ticks / 2 {
-            load.learn(&k, Q16::from_num(60), None, 1);
+            load.learn(&k, Q16::from_num(60), None, false, 1);
         }
         assert!(load.estimate.known().is_none() && load.estimate.value() > Q16::from_num(10));
         load.reading_changed();
@@ -284,7 +302,7 @@ mod tests {
         // Under the new reading the load is known after the full learning time, near −10 N·m.
         let mut calls = 0;
         while load.estimate.known().is_none() {
-            load.learn(&k, Q16::from_num(-10), None, 1);
+            load.learn(&k, Q16::from_num(-10), None, false, 1);
             calls += 1;
         }
         assert!(calls * SLOW.ticks >= k.known_ticks);
