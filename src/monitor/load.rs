@@ -87,7 +87,9 @@ impl LoadSettings {
 }
 
 /// The load estimate: learning (from zero at power-on) until the filter has run three time
-/// constants, then known; held with the drive off.
+/// constants, then known; held with the drive off. Known but *unseen* when last learned aiding
+/// the motion of a spring-only pack, which overruns on almost no drive torque whatever the
+/// load: no estimate resting on it is trusted.
 #[cfg_attr(
     feature = "config-block",
     derive(serde::Serialize, serde::Deserialize, Hash)
@@ -96,20 +98,21 @@ impl LoadSettings {
 pub(crate) enum LoadEstimate {
     Learning(Q16),
     Known(Q16),
+    Unseen(Q16),
 }
 
 impl LoadEstimate {
     #[inline]
     pub fn value(self) -> Q16 {
         match self {
-            LoadEstimate::Learning(x) | LoadEstimate::Known(x) => x,
+            LoadEstimate::Learning(x) | LoadEstimate::Known(x) | LoadEstimate::Unseen(x) => x,
         }
     }
 
     #[inline]
     pub fn known(self) -> Option<Q16> {
         match self {
-            LoadEstimate::Known(x) => Some(x),
+            LoadEstimate::Known(x) | LoadEstimate::Unseen(x) => Some(x),
             LoadEstimate::Learning(_) => None,
         }
     }
@@ -152,9 +155,6 @@ pub(crate) struct Load {
     /// The driving reading's load, learned beside the estimate while the overrunning reading
     /// is a power-on guess (`Classified::guessed`): the estimate's sign is not known.
     pub alt: Option<Q16>,
-    /// Last learned aiding the motion of a spring-only pack, which overruns on almost no drive
-    /// torque whatever the load: the load is not seen, and no estimate on it is trusted.
-    pub unseen: bool,
 }
 
 impl Load {
@@ -177,7 +177,6 @@ impl Load {
                 available: Q16::ZERO,
             },
             alt: None,
-            unseen: false,
         }
     }
 
@@ -197,7 +196,7 @@ impl Load {
 
     /// One slow-lane learning step with the load this call implies (`n` ticks elapsed) and, on
     /// a guessed reading, the other reading's; learning on a decided reading drops `alt`.
-    /// `unseen`: the reading does not show the load (see [`Load::unseen`]).
+    /// `unseen`: the reading does not show the load ([`LoadEstimate::Unseen`]).
     pub fn learn(
         &mut self,
         k: &LoadSettings,
@@ -206,21 +205,25 @@ impl Load {
         unseen: bool,
         n: u32,
     ) {
-        self.unseen = unseen;
         self.alt = other.map(|y| lowpass(self.alt.unwrap_or(self.estimate.value()), y, k.alpha));
         let value = lowpass(self.estimate.value(), implied, k.alpha);
         self.learn_ticks = self.learn_ticks.saturating_add(SLOW.covered(n));
-        self.estimate = match self.estimate {
+        let known = match self.estimate {
             LoadEstimate::Learning(_) if self.learn_ticks >= k.known_ticks => {
                 // First known load of a drive that started without one (power-on while
                 // driving): the drag check's reference from here on.
                 if self.reference.is_none() {
                     self.reference = Some(value);
                 }
-                LoadEstimate::Known(value)
+                true
             }
-            LoadEstimate::Learning(_) => LoadEstimate::Learning(value),
-            LoadEstimate::Known(_) => LoadEstimate::Known(value),
+            LoadEstimate::Learning(_) => false,
+            LoadEstimate::Known(_) | LoadEstimate::Unseen(_) => true,
+        };
+        self.estimate = match (known, unseen) {
+            (false, _) => LoadEstimate::Learning(value),
+            (true, false) => LoadEstimate::Known(value),
+            (true, true) => LoadEstimate::Unseen(value),
         };
     }
 
@@ -240,15 +243,15 @@ impl Load {
         self.cache_health();
     }
 
-    /// The load is known and its sign is not a power-on guess (`alt`): what trust and the
-    /// pack-health learning count on.
+    /// The load is known and its sign is not a power-on guess (`alt`): what the pack-health
+    /// learning counts on (trust also needs the load seen, [`Load::trusted`]).
     pub fn decided(&self) -> bool {
         self.estimate.known().is_some() && self.alt.is_none()
     }
 
-    /// [`Load::decided`] and seen: what an estimate resting on the load may be trusted on.
+    /// [`Load::decided`] and seen: an estimate resting on the load may be trusted.
     pub fn trusted(&self) -> bool {
-        self.decided() && !self.unseen
+        matches!(self.estimate, LoadEstimate::Known(_)) && self.alt.is_none()
     }
 
     /// Whether the cache was formed for another load.
