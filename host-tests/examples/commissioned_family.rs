@@ -11,10 +11,9 @@
 use host_tests::accuracy::{compare, run_monitor};
 use host_tests::commission::{commission_unit, ACCEPTANCE};
 use host_tests::family::{form, runs_and_seed, Family};
-use host_tests::mc::{draw_in, draw_trace, mirror, not_driven};
+use host_tests::mc::{draw_in, draw_trace, not_driven};
 use noback::monitor::Config;
 use noback_twin::scene::SceneKind;
-use noback_twin::trace::Trace;
 use std::collections::BTreeMap;
 
 #[derive(Default)]
@@ -52,18 +51,7 @@ fn main() -> Result<(), String> {
         t.runs += 1;
         let uncommissioned = compare(&trace, &run_monitor(&trace, Config::default())?);
         t.fa_uncommissioned += usize::from(!uncommissioned.flags.is_empty());
-        let s = &d.scene.sensors;
-        let installed = |t: &mut Trace| {
-            if d.mirrored {
-                mirror(
-                    t,
-                    s.current_adc_bits,
-                    s.motor_counter_bits,
-                    s.output_encoder_bits,
-                );
-            }
-        };
-        let c = match commission_unit(&d.scene, plan, installed) {
+        let c = match commission_unit(&d.scene, plan, |t| d.mount(t)) {
             Ok(c) => c,
             Err(e) => {
                 t.refused += 1;

@@ -373,16 +373,24 @@ pub fn draw_trace_after(d: &Draw, pre_roll_s: f64) -> Result<Trace, String> {
     for r in &mut trace.rows {
         r.t_s -= pre_roll_s;
     }
-    let s = &d.scene.sensors;
-    if d.mirrored {
-        mirror(
-            &mut trace,
-            s.current_adc_bits,
-            s.motor_counter_bits,
-            s.output_encoder_bits,
-        );
-    }
+    d.mount(&mut trace);
     Ok(trace)
+}
+
+impl Draw {
+    /// A trace of this draw's unit as its sensors are mounted: every reading negated
+    /// ([`mirror`]) when the draw is mirrored.
+    pub fn mount(&self, trace: &mut Trace) {
+        let s = &self.scene.sensors;
+        if self.mirrored {
+            mirror(
+                trace,
+                s.current_adc_bits,
+                s.motor_counter_bits,
+                s.output_encoder_bits,
+            );
+        }
+    }
 }
 
 mod run;

@@ -15,6 +15,7 @@ use host_tests::family::Family;
 use host_tests::mc::{draw_in, draw_legacy, run_all, Campaign as Setup, Draw, FAULT_KINDS};
 use part::{Campaign, Part};
 use std::io::Write as _;
+use std::ops::Range;
 use std::path::{Path, PathBuf};
 
 #[derive(Parser, Debug)]
@@ -199,11 +200,7 @@ pub fn run_part(setup: &Setup, campaign: Campaign, k: u64, n: u64, threads: usiz
     let nominal = part::slice(campaign.runs, k, n);
     let faults = part::slice(campaign.fault_runs, k, n);
     let seed = campaign.seed;
-    let draw = |seed, i, kind| draw_for(&campaign.plant_family, seed, i, kind);
-    let mut draws: Vec<_> = nominal.clone().map(|i| draw(seed, i, None)).collect();
-    for kind in FAULT_KINDS {
-        draws.extend(faults.clone().map(|i| draw(seed, i, Some(kind))));
-    }
+    let draws = draws_of(&campaign, nominal.clone(), faults.clone());
     eprintln!(
         "monitor-mc: shard {k}/{n}: nominal runs {}..{}, runs {}..{} of each fault kind ({} runs) on {threads} threads (seed {seed}, power-on settling {} s, pre-roll {} s)",
         nominal.start,
@@ -223,6 +220,16 @@ pub fn run_part(setup: &Setup, campaign: Campaign, k: u64, n: u64, threads: usiz
     let outcomes = run_all(&draws, setup, threads, &progress);
     eprintln!();
     Part::new(campaign, [k, n], nominal, faults, &outcomes)
+}
+
+/// A campaign's draws: the nominal runs `nominal`, then each fault kind's runs `faults`.
+fn draws_of(campaign: &Campaign, nominal: Range<u64>, faults: Range<u64>) -> Vec<Draw> {
+    let draw = |i, kind| draw_for(&campaign.plant_family, campaign.seed, i, kind);
+    let mut draws: Vec<_> = nominal.map(|i| draw(i, None)).collect();
+    for kind in FAULT_KINDS {
+        draws.extend(faults.clone().map(|i| draw(i, Some(kind))));
+    }
+    draws
 }
 
 /// Run `index` of a campaign of the named plant family.
@@ -246,14 +253,10 @@ fn draw_for(
 /// The plant form of every run of a campaign, in the outcomes' order (nominal, then each
 /// fault kind): a function of the draws alone, so a merge finds what the runs drew.
 fn forms_of(campaign: &Campaign) -> Vec<&'static str> {
-    let form = |i, kind| {
-        host_tests::family::form(&draw_for(&campaign.plant_family, campaign.seed, i, kind).scene)
-    };
-    let mut forms: Vec<_> = (0..campaign.runs).map(|i| form(i, None)).collect();
-    for kind in FAULT_KINDS {
-        forms.extend((0..campaign.fault_runs).map(|i| form(i, Some(kind))));
-    }
-    forms
+    draws_of(campaign, 0..campaign.runs, 0..campaign.fault_runs)
+        .iter()
+        .map(|d| host_tests::family::form(&d.scene))
+        .collect()
 }
 
 /// The campaign a run's arguments describe.

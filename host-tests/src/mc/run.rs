@@ -2,7 +2,7 @@
 //! draw's own acceptance runs, or not), one draw through the twin and the monitor, and every
 //! draw over the machine's cores.
 
-use super::{draw_trace_after, mirror, not_driven, Context, Draw, Outcome, PRE_ROLL_S};
+use super::{draw_trace_after, not_driven, Context, Draw, Outcome, PRE_ROLL_S};
 use crate::accuracy::{compare, detection_latency_s, manifest_time, run_monitor, run_monitor_with};
 use crate::dormant::functional_test_after;
 use crate::family::Family;
@@ -121,17 +121,7 @@ pub fn evaluate(d: &Draw, campaign: &Campaign) -> Outcome {
 /// A draw's unit commissioned on the acceptance procedure ([`crate::commission::ACCEPTANCE`])
 /// of its healthy plant, its sensors mounted as the draw's.
 pub fn commission_draw(d: &Draw) -> Result<crate::commission::Commissioning, String> {
-    let s = &d.scene.sensors;
-    crate::commission::commission_unit(&d.scene, &crate::commission::ACCEPTANCE, |t| {
-        if d.mirrored {
-            mirror(
-                t,
-                s.current_adc_bits,
-                s.motor_counter_bits,
-                s.output_encoder_bits,
-            );
-        }
-    })
+    crate::commission::commission_unit(&d.scene, &crate::commission::ACCEPTANCE, |t| d.mount(t))
 }
 
 /// Runs every draw on `threads` workers, calling `progress(done, total)` as runs finish.

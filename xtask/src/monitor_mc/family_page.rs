@@ -7,8 +7,8 @@ use super::report::{by_form, rate, FORMS};
 use crate::shell::workspace_root;
 use clap::Args;
 use host_tests::accuracy::Braking;
-use host_tests::family::Family;
-use host_tests::mc::{draw_in, run_all, Campaign as Setup, FAULT_KINDS};
+use host_tests::family::{form, Family};
+use host_tests::mc::{run_all, Campaign as Setup, FAULT_KINDS};
 use serde_json::{json, Value};
 use std::fmt::Write as _;
 
@@ -44,19 +44,14 @@ fn campaign(seed: u64, commissioned: bool, a: &FamilyArgs) -> Result<Value, Stri
     let mut setup = Setup::for_family(Family::Plant);
     setup.commissioned = commissioned;
     let c = super::campaign_of(&setup, Family::Plant, seed, a.runs, a.fault_runs);
-    let mut draws: Vec<_> = (0..a.runs)
-        .map(|i| draw_in(Family::Plant, seed, i, None))
-        .collect();
-    for kind in FAULT_KINDS {
-        draws.extend((0..a.fault_runs).map(|i| draw_in(Family::Plant, seed, i, Some(kind))));
-    }
+    let draws = super::draws_of(&c, 0..a.runs, 0..a.fault_runs);
     eprintln!(
         "monitor-mc family: seed {seed}, {}commissioned: {} runs",
         if commissioned { "" } else { "un" },
         draws.len()
     );
     let outcomes = run_all(&draws, &setup, super::threads(None), &|_, _| {});
-    let forms = super::forms_of(&c);
+    let forms: Vec<&str> = draws.iter().map(|d| form(&d.scene)).collect();
     let mut report = by_form(&outcomes, &forms, commissioned);
     for form in FORMS {
         let runs: Vec<Braking> = outcomes
