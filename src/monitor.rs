@@ -73,6 +73,7 @@ mod sense;
 mod settings;
 #[cfg(feature = "snapshot")]
 mod snapshot;
+mod stop;
 
 pub use config::{
     Config, ConfigError, DrivingPack, ObserverGains, Thresholds, DEFAULT_BRAKING_MODEL_HZ,
@@ -313,7 +314,7 @@ impl Monitor {
         }
         // Check: the braking envelope and creep, on this tick's motion.
         let dir = Dir::of(o.w, k.scene.stick_speed);
-        let braking = (st.classify.scene() == Scene::FaultBraking).then(|| BrakingTick {
+        let braking = st.classify.enveloped().then(|| BrakingTick {
             n: x.n,
             tick: st.tick,
             d_out: x.d_out,
@@ -328,9 +329,8 @@ impl Monitor {
         // The pack torque the observer's model feeds forward into the next prediction.
         let model = estimate::model_torque(
             &k.pack,
-            x.drive,
             st.classify.locked(),
-            st.classify.overrunning(),
+            st.classify.model_capacity(x.drive),
             dir,
             st.observe.disturbance().saturating_add(o.drive_torque),
             o.drive_torque,
@@ -419,11 +419,11 @@ impl State {
             refresh_load(&mut self.load, k);
         }
         // The pack's torque is known against an opposing load only where both socket faces
-        // clamp (`learn_opposed`), not on a guessed sign (`alt`), nor after a drive whose
-        // input ran ahead of the output (where the pack engages is unknown).
+        // clamp (`learn_opposed`), not on a guessed sign (`alt`), nor where the pack engages is
+        // unknown (an input that ran ahead, a spring-only pack's turn-back).
         let learnable = self.load.decided()
             && (k.load.learn_opposed || c.load_along)
-            && !self.classify.input_ran_ahead(&k.scene);
+            && self.classify.engagement_known(&k.scene);
         if moving_ok && !x.drive && learnable {
             let measured = load.saturating_sub(o.net);
             self.load.learn_health(&k.load, c.dir.apply(measured));

@@ -6,8 +6,8 @@
 //! |---|---|---|
 //! | `Driving` | `F_drive = F_s/(1 + a·k)` | Table 1 at the drive drag `a·F_drive` |
 //! | `Overrunning` | `F_s + k·(T_o − v)`, `T_o = y − v` | `y = g₁·v − g₀` against the motion |
-//! | `Holding` | `F_s + k·|T|` | `T = M̂ − J_s·α` (α from the impacts of the rattle) |
-//! | `FaultBraking` | `F_s + k·|T|` (`F_s` for a spring-only pack against the load) | `T` measured: `M̂ − (J_s·ω̇ − u)` |
+//! | `Holding` | `F_s + k·|T|` (`F_s`: a spring-only pack's ramps open) | `T = M̂ − J_s·α` (α from the impacts of the rattle) |
+//! | `FaultBraking` | `F_s + k·|T|`; a spring-only pack: `F_s`, ramps open (against the load, turning back: `stop.rs`), else `F_s + k·|M̂|` | `T` measured: `M̂ − (J_s·ω̇ − u)` |
 //!
 //! Engaged, the torque is bounded by the capacity at that force (it binds only when the force
 //! saturates or the pack does not self-lock).
@@ -57,25 +57,34 @@ pub(crate) struct PackEstimate {
     pub braking_torque: Q16,
 }
 
+/// Which capacity the observer's pack model takes (`Classify::model_capacity`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) enum ModelCapacity {
+    /// The pack's drag: the drive carries the load, or a spring-only pack's ramps are open.
+    Drag,
+    /// The overrunning equilibrium at the drive torque.
+    Overrunning,
+    /// The engaged pack's capacity at the load.
+    Engaged,
+}
+
 /// The pack torque the observer's model feeds forward, every tick: Table 1 on the model's own
 /// demand (its load state plus the drive torque), so that a stuck model stays at rest whatever
 /// the observer has absorbed (Karnopp), with the capacity of the present reading.
-#[allow(clippy::too_many_arguments)]
 #[inline]
 pub(crate) fn model_torque(
     k: &PackSettings,
-    drive: bool,
     locked: bool,
-    overrunning: bool,
+    model: ModelCapacity,
     dir: Dir,
     demand: Q16,
     drive_torque: Q16,
     engaged_capacity: Q16,
 ) -> Q16 {
-    let capacity = match (drive, overrunning) {
-        (false, _) => engaged_capacity,
-        (true, false) => k.drive_drag,
-        (true, true) => k.overrun_torque(dir.apply(drive_torque)),
+    let capacity = match model {
+        ModelCapacity::Engaged => engaged_capacity,
+        ModelCapacity::Drag => k.drive_drag,
+        ModelCapacity::Overrunning => k.overrun_torque(dir.apply(drive_torque)),
     };
     table1(locked || dir.is_none(), dir, demand, capacity)
 }
@@ -128,15 +137,14 @@ pub(crate) fn pack(k: &PackSettings, c: &Classified, i: &PackInputs) -> PackEsti
             } else {
                 i.measured
             };
-            let open = k.spring_only && c.scene == Scene::FaultBraking && !c.load_along;
-            (
-                if open {
-                    k.spring_force
-                } else {
-                    k.clamped_force(t)
-                },
-                t,
-            )
+            // A spring-only pack's ramps carry the load alone: open against it, clamped by it.
+            let force = match (k.spring_only, c.scene) {
+                _ if c.ramps_open => k.spring_force,
+                (true, Scene::FaultBraking) if !c.load_along => k.spring_force,
+                (true, Scene::FaultBraking) => k.clamped_force(i.load),
+                _ => k.clamped_force(t),
+            };
+            (force, t)
         }
     };
     // Carried by the drive, the drag is a constant below the capacity: no bound needed.

@@ -4,7 +4,7 @@
 //! | state | when | leaves |
 //! |---|---|---|
 //! | `Driving(reading)` | drive on | drive off → `Braking` |
-//! | `Braking` | drive off, output moving | stopped 1 ms or thrown back → `Holding`; drive on |
+//! | `Braking` | drive off, output moving | the stop rule (`stop.rs`) → `Holding`; drive on |
 //! | `Holding` | drive off, the pack holds | a slip check → `Braking`; drive on |
 //!
 //! While driving, the *reading* says who carries the load: the drive (`Driving` scene: pack at
@@ -21,12 +21,14 @@
 
 use super::config::{Config, ConfigError, DrivingPack};
 use super::convert::{counts, positive, q16, ticks};
+use super::estimate::ModelCapacity;
 use super::load::LoadEstimate;
 use super::observe::Observed;
 use super::pack::{Dir, PackSettings};
 use super::scale::Scale;
 use super::schedule::WINDOW;
 use super::sense::Sensed;
+use super::stop::{Motion, StopSettings, Turn};
 use super::{convert::scale, Scene};
 use crate::fx::{counter_delta, Q16};
 
@@ -44,7 +46,7 @@ pub(crate) struct SceneSettings {
     pub stick_speed: Q16,
     pub min_load: Q16,
     pub max_load: Q16,
-    lock_dwell_ticks: u32,
+    stop: StopSettings,
     pub engage_settle_ticks: u32,
     settle_ticks: u32,
     out_bits: u8,
@@ -65,11 +67,12 @@ impl SceneSettings {
     pub fn new(c: &Config, settle_ticks: u32) -> Result<SceneSettings, ConfigError> {
         let (s, t, tick_hz) = (&c.sensors, &c.thresholds, c.tick_hz);
         let (out_rad, in_rad) = (s.output_rad_per_count(), s.input_rad_per_motor_count());
+        let stick_speed = q16(
+            positive(t.stick_speed_rad_s, "thresholds.stick_speed_rad_s")?,
+            "thresholds.stick_speed_rad_s",
+        )?;
         Ok(SceneSettings {
-            stick_speed: q16(
-                positive(t.stick_speed_rad_s, "thresholds.stick_speed_rad_s")?,
-                "thresholds.stick_speed_rad_s",
-            )?,
+            stick_speed,
             min_load: q16(
                 positive(t.min_load_nm, "thresholds.min_load_nm")?,
                 "thresholds.min_load_nm",
@@ -78,7 +81,7 @@ impl SceneSettings {
                 positive(t.max_load_nm, "thresholds.max_load_nm")?,
                 "thresholds.max_load_nm",
             )?,
-            lock_dwell_ticks: ticks(t.lock_dwell_s, tick_hz, "thresholds.lock_dwell_s")?,
+            stop: StopSettings::new(c)?,
             engage_settle_ticks: ticks(t.engage_settle_s, tick_hz, "thresholds.engage_settle_s")?,
             settle_ticks,
             out_bits: s.output_encoder_bits,
@@ -150,6 +153,8 @@ pub(crate) struct Classified {
     pub reading_switch: bool,
     /// The brake locked this call.
     pub just_locked: bool,
+    /// A spring-only pack's ramps open (`F = F_s`): cut against the load, not clamped since.
+    pub ramps_open: bool,
     /// The scene has lasted `engage_settle_s`.
     pub phase_settled: bool,
     /// The drive has run steadily (output with the input) for `engage_settle_s` / the
@@ -170,6 +175,7 @@ impl Classified {
         guessed: false,
         reading_switch: false,
         just_locked: false,
+        ramps_open: false,
         phase_settled: false,
         steady_for_learning: false,
         steady_for_checks: false,
@@ -204,6 +210,7 @@ pub(crate) struct Classify {
     sync_motor: u32,
     /// Ticks since the last classification.
     since: u32,
+    turn: Turn,
 }
 
 impl Classify {
@@ -220,6 +227,7 @@ impl Classify {
             sync_out: 0,
             sync_motor: 0,
             since: 0,
+            turn: Turn::None,
         }
     }
 
@@ -243,11 +251,6 @@ impl Classify {
                 Phase::Braking
             };
         }
-    }
-
-    /// Whether the drive runs with the load along the motion (the pack carries it).
-    pub fn overrunning(&self) -> bool {
-        matches!(self.phase, Phase::Driving(r) if r.overrunning)
     }
 
     /// The previous call's scene.
@@ -275,6 +278,12 @@ impl Classify {
         let mut overrun_torque = Q16::ZERO;
         let mut just_locked = false;
         let prev = self.phase;
+        if x.drive {
+            let against = dir
+                .apply(load.known().unwrap_or(Q16::ZERO))
+                .saturating_neg();
+            self.turn = Turn::at_cut(&k.stop, against, k.min_load);
+        }
         self.phase = match (x.drive, prev) {
             (true, _) if dir.is_none() => Phase::Driving(Reading::none()),
             (true, p) => {
@@ -310,9 +319,16 @@ impl Classify {
                 // The brake stops the output: it dwells in the stick band, or an impact in the
                 // lost motion throws it back within a tick or two.
                 let reversed = dir.opposes(self.last_dir);
+                let m = Motion {
+                    reversed,
+                    out: x.out,
+                    out_bits: k.out_bits,
+                    w: o.w,
+                    stick_speed: k.stick_speed,
+                };
                 match p {
                     Phase::Holding => Phase::Holding,
-                    _ if self.stick_ticks >= k.lock_dwell_ticks || reversed => {
+                    _ if self.turn.stops(&k.stop, &mut self.stick_ticks, &m) => {
                         just_locked = true;
                         Phase::Holding
                     }
@@ -354,6 +370,7 @@ impl Classify {
             guessed: matches!(self.phase, Phase::Driving(r) if r.overrunning && r.guessed),
             reading_switch,
             just_locked,
+            ramps_open: self.turn.ramps_open(),
             phase_settled: self.phase_ticks >= k.engage_settle_ticks,
             steady_for_learning,
             steady_for_checks,
@@ -363,7 +380,7 @@ impl Classify {
     /// A slip check saw the pack give way: the brake no longer holds.
     pub fn lose_hold(&mut self) {
         if self.phase == Phase::Holding {
-            self.phase = Phase::Braking;
+            (self.phase, self.turn) = (Phase::Braking, Turn::None);
         }
     }
 
@@ -375,6 +392,30 @@ impl Classify {
             .apply(self.ahead_motor)
             .saturating_sub(self.ahead_out)
             > k.ahead_counts
+    }
+
+    /// Where the pack engages is known: the input did not run ahead of the output, and a
+    /// spring-only pack cut against the load is not braking before its lock (`stop.rs`).
+    pub fn engagement_known(&self, k: &SceneSettings) -> bool {
+        let turning = self.phase == Phase::Braking && self.turn != Turn::None;
+        !(turning || self.input_ran_ahead(k))
+    }
+
+    /// The capacity the observer's pack model takes: the drag while the drive carries the
+    /// load or a spring-only pack's ramps are open.
+    pub fn model_capacity(&self, drive: bool) -> ModelCapacity {
+        match (drive, self.phase) {
+            (true, Phase::Driving(r)) if r.overrunning => ModelCapacity::Overrunning,
+            (true, _) => ModelCapacity::Drag,
+            (false, Phase::Braking) if self.turn.ramps_open() => ModelCapacity::Drag,
+            (false, _) => ModelCapacity::Engaged,
+        }
+    }
+
+    /// Braking, judged by the braking envelope (after a turn-back the stop rule's travel limits
+    /// judge it).
+    pub fn enveloped(&self) -> bool {
+        self.scene == Scene::FaultBraking && !self.turn.turned_back()
     }
 
     /// Whether the brake is locked (holding).

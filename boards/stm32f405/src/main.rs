@@ -16,7 +16,7 @@ compile_error!("choose one build: `qemu` (the default) or `hw` (--no-default-fea
 
 #[cfg(all(target_os = "none", feature = "hw"))]
 mod sensors;
-// On a part: defmt frames over RTT, panics reported to the probe.
+// On a part: defmt frames over RTT, panics reported to the probe (its backtrace, no message).
 #[cfg(all(target_os = "none", feature = "hw"))]
 use {defmt_rtt as _, panic_probe as _};
 
