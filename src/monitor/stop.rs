@@ -120,7 +120,7 @@ impl Turn {
                 *still = 0;
                 (false, Turn::Back(m.out, Q16::ZERO))
             }
-            Turn::Expected => (*still >= k.turn_back_dwell_ticks, Turn::None),
+            Turn::Expected => (*still >= k.turn_back_dwell_ticks, Turn::Expected),
             Turn::Back(at, _) if beyond(at, k.turn_back_counts) => (true, Turn::None),
             Turn::Back(at, peak) => {
                 let w = m.w.saturating_abs();
@@ -139,12 +139,11 @@ impl Turn {
             }
             t => (*still >= k.lock_dwell_ticks || m.reversed, t),
         };
-        // Locked, only a spring-held pack keeps its ramps open; an expected turn waits.
-        *self = match (lock, next) {
-            (true, Turn::Against) => Turn::Against,
-            (true, _) => Turn::None,
-            (false, Turn::None) if *self == Turn::Expected => Turn::Expected,
-            (false, t) => t,
+        // Locked, only a spring-held pack keeps its ramps open.
+        *self = if lock && next != Turn::Against {
+            Turn::None
+        } else {
+            next
         };
         lock
     }
