@@ -17,7 +17,7 @@ use crc::{Crc, CRC_32_ISCSI};
 
 /// The block's first bytes.
 pub const CONFIG_BLOCK_MAGIC: [u8; 4] = *b"NBCB";
-/// Room the firmware keeps for a block (the default settings' block takes 309 bytes).
+/// Room the firmware keeps for a block (the default settings' block takes 318 bytes).
 pub const CONFIG_BLOCK_BYTES: usize = 1024;
 
 const CRC: Crc<u32> = Crc::<u32>::new(&CRC_32_ISCSI);
