@@ -24,7 +24,7 @@
 //! | sense | `sense` | raw ADC code, counters, drive command | counts, deltas, plausibility |
 //! | observe | `observe`, `observer` | current, output angle | drive torque, ω̂, `J_s·ω̇ − u`, settling |
 //! | classify | `scene` | ω̂, drive torque, load | scene (one state machine), direction, overrunning torque |
-//! | estimate | `load`, `pack`, `estimate` | all above | load, health, pressing force, braking torque, model torque |
+//! | estimate | `load`, `aiding`, `pack`, `estimate` | all above | load (an aiding one at the lock), health, pressing force, braking torque, model torque |
 //! | check | `checks` | all above | flags raised this tick |
 //! | flag | here | raised flags | latched [`Flags`] in the [`Estimate`] |
 //!
@@ -45,8 +45,8 @@
 //! | friction energy | `U40F24`, saturating | 1.1e12 J | 6e-8 J |
 //! | counters, timers | `i32`/`u32`, saturating; counter differences wrapping | — | 1 count / 1 tick |
 //!
-//! No division and no floating point in [`Monitor::step`]; every constant is derived in
-//! [`Monitor::new`].
+//! No floating point in [`Monitor::step`], and one division: at a lock after an aiding load
+//! (`aiding`); every constant is derived in [`Monitor::new`].
 //!
 //! # Missed ticks
 //! [`Inputs::ticks_elapsed`] is the number of ticks since the previous call (1 when on time).
@@ -54,6 +54,7 @@
 //! plausibility limits; above `max_catchup_ticks` the observer is re-seated on the measurement
 //! and the estimate is untrusted until it settles again.
 
+mod aiding;
 mod checks;
 mod config;
 #[cfg(feature = "config-block")]
@@ -75,9 +76,10 @@ mod settings;
 mod snapshot;
 mod stop;
 
+pub use crate::fx::mul_q16;
 pub use config::{
-    Config, ConfigError, DrivingPack, ObserverGains, Thresholds, DEFAULT_BRAKING_MODEL_HZ,
-    DEFAULT_OBSERVER_BANDWIDTH_HZ, DEFAULT_TICK_HZ, POWER_ON_SEED_TICKS,
+    AidingBraking, Config, ConfigError, DrivingPack, ObserverGains, Thresholds,
+    DEFAULT_BRAKING_MODEL_HZ, DEFAULT_OBSERVER_BANDWIDTH_HZ, DEFAULT_TICK_HZ, POWER_ON_SEED_TICKS,
 };
 pub use io::{BrakeState, Estimate, Flags, Inputs, Scene, SceneModel, ESTIMATE_WORDS};
 pub use scale::{sat_i32, Scale, ScaleError};
@@ -85,6 +87,7 @@ pub use scale::{sat_i32, Scale, ScaleError};
 pub use snapshot::SnapshotError;
 
 use crate::fx::Q16;
+use aiding::Cut;
 use checks::{BrakingTick, CheckInputs, Checks};
 use estimate::{Energy, PackInputs};
 use functional_test::{FunctionalTest, TestReport};
@@ -98,16 +101,6 @@ pub use settings::Settings;
 
 /// Largest capacity margin reported (the load stage's builder keeps margins below it).
 pub const MARGIN_MAX: Q16 = Q16::from_bits(1000 << 16);
-
-/// `a·b` for two Q16 values, rounded toward −∞ and saturated: the bits of `fixed`'s
-/// `saturating_mul`, as one 32×32→64 multiply, a shift and a clamp (cheaper on Cortex-M).
-#[inline]
-pub fn mul_q16(a: Q16, b: Q16) -> Q16 {
-    // |a·b| ≤ 2^62: the product fits an i64; `>> 16` is the floor.
-    Q16::from_bits(sat_i32(
-        crate::fx::widening_mul(a.to_bits(), b.to_bits()) >> 16,
-    ))
-}
 
 /// The monitor's state: one value per stage.
 #[cfg_attr(
@@ -154,6 +147,8 @@ pub struct Monitor {
     job: Job,
     /// `job` waits for [`Monitor::background`].
     job_due: bool,
+    /// Where the drive was last cut, until the lock after it (`aiding`).
+    cut: Option<Cut>,
 }
 
 impl Monitor {
@@ -178,7 +173,7 @@ impl Monitor {
     #[inline(always)]
     pub fn with_settings(settings: &Settings) -> Monitor {
         let mut load = Load::new();
-        refresh_load(&mut load, settings);
+        settings.refresh_load(&mut load);
         Monitor {
             settings: *settings,
             state: State {
@@ -204,6 +199,7 @@ impl Monitor {
                 o: Observed::NONE,
             },
             job_due: false,
+            cut: None,
         }
     }
 
@@ -303,14 +299,19 @@ impl Monitor {
         if !core::mem::take(&mut self.job_due) {
             return;
         }
-        let (k, st) = (&self.settings, &mut self.state);
+        let (k, st, cut) = (&self.settings, &mut self.state, &mut self.cut);
         let Job { ref x, ref o } = self.job;
         let slot = Slot::of(st.tick);
         // The tick's events: a drive edge, an implausible step.
         st.classify.tick(x, o);
         st.checks.events(&k.checks, x, o);
-        if x.drive_edge && x.drive {
-            st.load.drive_started();
+        if x.drive_edge {
+            *cut = (!x.drive && k.aiding.is_some()).then(|| Cut::at(o));
+            if x.drive {
+                st.load.drive_started();
+            }
+        } else if let Some(cut) = cut.as_mut() {
+            cut.travel(x);
         }
         // Check: the braking envelope and creep, on this tick's motion.
         let dir = Dir::of(o.w, k.scene.stick_speed);
@@ -343,7 +344,14 @@ impl Monitor {
                 reading_switch = st.classify(k, x, o);
                 st.estimate(k);
             }
-            Slot::Classify => reading_switch = st.classify(k, x, o),
+            Slot::Classify => {
+                reading_switch = st.classify(k, x, o);
+                // An aiding load a spring-only pack hid while driving, read at the lock.
+                let locked = st.classified.just_locked.then(|| cut.take()).flatten();
+                if aiding::read_at_lock(locked, k.aiding.as_ref(), &mut st.load) {
+                    k.refresh_load(&mut st.load);
+                }
+            }
             Slot::Estimate => st.estimate(k),
             Slot::Sync if x.drive => st.classify.sync_window(&k.scene, x, o.w),
             _ => {}
@@ -416,7 +424,7 @@ impl State {
         // The cache follows a changing load once per window while driving (never on a drive
         // edge); with the drive off the load is held, and so is the cache.
         if x.drive && !x.drive_edge && WINDOW.slot(self.tick) == 0 && self.load.cache_stale() {
-            refresh_load(&mut self.load, k);
+            k.refresh_load(&mut self.load);
         }
         // The pack's torque is known against an opposing load only where both socket faces
         // clamp (`learn_opposed`), not on a guessed sign (`alt`), nor where the pack engages is
@@ -516,18 +524,9 @@ impl State {
     }
 }
 
-/// `load`'s cache for its present load (capacity, margin floor, decelerations).
-fn refresh_load(load: &mut Load, k: &Settings) {
-    let value = load.estimate.value();
-    let capacity = k.pack.capacity(k.pack.clamped_force(value));
-    let decel = k.checks.envelope.decelerations(capacity, value, load.alt);
-    load.refresh(&k.load, value, capacity, decel);
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::fx::Q16;
 
     #[test]
     fn holding_torque_carries_the_inertia_torque_of_an_impact() {
@@ -559,42 +558,5 @@ mod tests {
         // is floored (error in [0, 1) count), so `θ₀ − 2θ_m + θ_2m` is within 2 counts of the
         // true parabola's: |error| < 45 N·m, against a 300 N·m impact.
         assert!(worst < 45.0, "{worst}");
-    }
-
-    #[test]
-    fn mul_q16_has_the_bits_of_fixed_saturating_mul() {
-        let mut x = 0x2545_F491_u32;
-        let mut next = || {
-            x ^= x << 13;
-            x ^= x >> 17;
-            x ^= x << 5;
-            x as i32
-        };
-        let edges = [
-            0,
-            1,
-            -1,
-            65_536,
-            -65_536,
-            i32::MAX,
-            i32::MIN,
-            0x7FFF,
-            -0x8000,
-        ];
-        for &a in &edges {
-            for &b in &edges {
-                let (qa, qb) = (Q16::from_bits(a), Q16::from_bits(b));
-                assert_eq!(mul_q16(qa, qb), qa.saturating_mul(qb), "{a} × {b}");
-            }
-        }
-        for _ in 0..100_000 {
-            // Full range, and values of physical size (|x| < 2^24 bits = 256).
-            let (a, b) = (next(), next());
-            let (c, d) = (next() >> 8, next() >> 8);
-            for (a, b) in [(a, b), (c, d), (a, d)] {
-                let (qa, qb) = (Q16::from_bits(a), Q16::from_bits(b));
-                assert_eq!(mul_q16(qa, qb), qa.saturating_mul(qb), "{a} × {b}");
-            }
-        }
     }
 }

@@ -11,6 +11,7 @@
 //! | pack drag while driving | steady drive torque / gain − the load | `sliding_mu` (spring-only, or no closing run) |
 //! | overrunning equilibrium (a closing run) | `y = L + v` against `g₁(μ)·v − g₀(μ)` | `sliding_mu` (relieved) |
 //! | braking against the load | the output's deceleration to its turning point: `J·α − M` | `braking_share` (0.8 × its share of the capacity) |
+//! | a spring-only pack's braking (two opening loads and a closing) | the decelerations `ω₀²/(2θ)`: openings `J·α = M + D`, the closing `J·α = D + g·M` | `aiding_braking` |
 //! | form | that braking over the drag: the ramps clamp from the cut (> 3) or it is the drag alone (≈ 1) | `driving_pack`, braking-angle allowance, dead-current check |
 //!
 //! The pack's static capacity is not identified: it needs the brake made to slip (a functional
@@ -19,7 +20,7 @@
 use crate::accuracy::{run_monitor, scene_trace};
 use noback::fx::{adc_centered, counter_delta};
 use noback::mechanism::Mechanism;
-use noback::monitor::{Config, DrivingPack, Thresholds};
+use noback::monitor::{AidingBraking, Config, DrivingPack, Thresholds};
 use noback_twin::scene::{Scene, SceneKind};
 use noback_twin::trace::Trace;
 
@@ -66,6 +67,8 @@ pub struct RunFigures {
     pub braking_time_s: f64,
     pub braking_nm: f64,
     pub braking_share: f64,
+    /// The output's mean deceleration to its turning point, `ω₀²/(2θ)` (rad/s²).
+    pub decel_rad_s2: f64,
 }
 
 /// What the acceptance runs showed, and the configuration set from them.
@@ -77,6 +80,8 @@ pub struct Commissioning {
     pub current_offset_a: f64,
     pub drive_drag_nm: f64,
     pub braking_share: f64,
+    /// A spring-only pack's braking of an aiding load, where the runs identify it.
+    pub aiding: Option<AidingBraking>,
     pub config: Config,
 }
 
@@ -213,6 +218,7 @@ fn measure(
             .min_by(|a, b| (-dir * a.1).total_cmp(&(-dir * b.1)))
             .map_or(0, |(i, _)| i);
     let braking_time = (stop - cut) as f64 * dt;
+    let braking_angle = (theta[stop] - theta[cut]).abs();
     if braking_time <= 2.0 * dt {
         return Err("the output did not move after the cut".into());
     }
@@ -233,6 +239,7 @@ fn measure(
         braking_time_s: braking_time,
         braking_nm: opposed,
         braking_share: opposed / capacity,
+        decel_rad_s2: speed * speed / (2.0 * braking_angle),
     })
 }
 
@@ -334,7 +341,11 @@ pub fn commission(runs: &[(&Trace, f64)]) -> Result<Commissioning, String> {
         (false, _) => drag / spring,
     };
     let braking_share = heaviest.braking_share;
+    let aiding = (!relieved)
+        .then(|| aiding_braking(&opening, closing?, base.mechanism.output_inertia_kg_m2))
+        .flatten();
     let mut config = configured(base, a, braking_share, relieved);
+    config.aiding_braking = aiding;
     // The monitor's torque per amp, so that its drive torque reads true.
     config.sensors.motor_torque_constant_nm_a /= gain;
     config.commissioned = true;
@@ -345,7 +356,35 @@ pub fn commission(runs: &[(&Trace, f64)]) -> Result<Commissioning, String> {
         current_offset_a: config.current_offset_a,
         drive_drag_nm: drag,
         braking_share,
+        aiding,
         config,
+    })
+}
+
+/// A spring-only pack's braking, `J·α = D + g·M` along an aiding load, from the openings' (ramps
+/// open: `J·α = M + D`, two loads give `J` and `D`) and a closing's deceleration. `None` without
+/// two opening loads [`MIN_LOAD_SPAN_NM`] apart, or where the figures are implausible.
+fn aiding_braking(opening: &[&RunFigures], closing: &RunFigures, j: f64) -> Option<AidingBraking> {
+    let (lo, hi) = (
+        opening
+            .iter()
+            .min_by(|a, b| a.load_nm.total_cmp(&b.load_nm))?,
+        opening
+            .iter()
+            .max_by(|a, b| a.load_nm.total_cmp(&b.load_nm))?,
+    );
+    if hi.load_nm - lo.load_nm < MIN_LOAD_SPAN_NM {
+        return None;
+    }
+    let inertia = (hi.load_nm - lo.load_nm) / (hi.decel_rad_s2 - lo.decel_rad_s2);
+    let drag = inertia * hi.decel_rad_s2 - hi.load_nm;
+    let gain = (inertia * closing.decel_rad_s2 - drag) / closing.load_nm;
+    let plausible =
+        (GAIN_RANGE.0..=GAIN_RANGE.1).contains(&(inertia / j)) && drag > 0.0 && gain > 0.0;
+    plausible.then_some(AidingBraking {
+        inertia_kg_m2: inertia,
+        drag_nm: drag,
+        load_gain: gain,
     })
 }
 

@@ -17,10 +17,14 @@
 //! expected_breakaway_nm = 11.0   # the unit's acceptance test (absent: the design's)
 //! expected_opening_nm = 24.8     # and its opening torque (needs the breakaway)
 //! min_margin = 0.95
+//! [monitor.aiding_braking]       # a spring-only pack's braking (AidingBraking), all three
+//! inertia_kg_m2 = 0.15
+//! drag_nm = 8.4
+//! load_gain = 1.5
 //! ```
 
 use noback::monitor::functional_test::TestConfig;
-use noback::monitor::{Config, DrivingPack, Monitor, Thresholds};
+use noback::monitor::{AidingBraking, Config, DrivingPack, Monitor, Thresholds};
 use toml::{Table, Value};
 
 fn number(v: &Value, key: &str) -> Result<f64, String> {
@@ -104,6 +108,22 @@ fn functional_test(mut given: Table) -> Result<TestConfig, String> {
     Ok(t)
 }
 
+/// `[monitor.aiding_braking]`: every field given.
+fn aiding_braking(mut given: Table) -> Result<AidingBraking, String> {
+    let mut get = |key: &str| {
+        let path = format!("monitor.aiding_braking.{key}");
+        let v = given.remove(key).ok_or(format!("{path}: missing"))?;
+        number(&v, &path)
+    };
+    let a = AidingBraking {
+        inertia_kg_m2: get("inertia_kg_m2")?,
+        drag_nm: get("drag_nm")?,
+        load_gain: get("load_gain")?,
+    };
+    no_more(&given, "monitor.aiding_braking.")?;
+    Ok(a)
+}
+
 /// Parses a configuration file's text; the result is validated by `Monitor::new`.
 pub fn parse(text: &str) -> Result<Config, String> {
     let mut root: Table = text
@@ -127,6 +147,9 @@ pub fn parse(text: &str) -> Result<Config, String> {
     }
     if let Some(t) = m.remove("functional_test") {
         c.functional_test = functional_test(table(t, "monitor.functional_test")?)?;
+    }
+    if let Some(t) = m.remove("aiding_braking") {
+        c.aiding_braking = Some(aiding_braking(table(t, "monitor.aiding_braking")?)?);
     }
     for (key, field) in [
         ("capacity_mu", &mut c.capacity_mu),
@@ -219,6 +242,12 @@ pub fn write(c: &Config, comment: &str) -> Result<String, String> {
         out.push_str("[monitor.functional_test]\n");
         out.push_str(&test);
     }
+    if let Some(a) = c.aiding_braking {
+        out.push_str(&format!(
+            "[monitor.aiding_braking]\ninertia_kg_m2 = {:?}\ndrag_nm = {:?}\nload_gain = {:?}\n",
+            a.inertia_kg_m2, a.drag_nm, a.load_gain
+        ));
+    }
     match parse(&out) {
         Ok(back) if back == *c => Ok(out),
         Ok(_) => Err("the configuration sets a field the file does not carry".into()),
@@ -255,6 +284,11 @@ mod tests {
             ..TestConfig::DEFAULT
         }
         .commissioned(10.25, 24.5);
+        c.aiding_braking = Some(AidingBraking {
+            inertia_kg_m2: 0.1512345,
+            drag_nm: 8.25,
+            load_gain: 1.625,
+        });
         let text = write(&c, "test").unwrap();
         assert_eq!(parse(&text), Ok(c), "{text}");
         let mut other = c;

@@ -262,6 +262,19 @@ pub enum DrivingPack {
     SpringOnly,
 }
 
+/// What commissioning identified of a spring-only pack braking a load that aids the motion
+/// (docs/commissioning.md): `J·α = D + g·M` from the cut to the lock (`aiding.rs`).
+#[cfg_attr(feature = "config-block", derive(serde::Serialize, serde::Deserialize))]
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct AidingBraking {
+    /// `J`: the output's inertia as its braking shows it (kg·m²).
+    pub inertia_kg_m2: f64,
+    /// `D`: the pack's braking torque with the ramps seated (N·m).
+    pub drag_nm: f64,
+    /// `g = a·k − 1`: braking torque gained per N·m of the load, less the load.
+    pub load_gain: f64,
+}
+
 /// Everything the monitor is configured with; separate from its state. With `config-block`,
 /// serde writes it as the firmware's configuration block (`config_block`).
 #[cfg_attr(feature = "config-block", derive(serde::Serialize, serde::Deserialize))]
@@ -289,6 +302,8 @@ pub struct Config {
     pub backdrive_efficiency: f64,
     /// How the pack is pressed while driving against the load (its force and drag then).
     pub driving_pack: DrivingPack,
+    /// A spring-only pack's braking of an aiding load, once identified (else `None`).
+    pub aiding_braking: Option<AidingBraking>,
     /// The phase-current reading at zero current (A), measured at commissioning with the drive
     /// off; subtracted in whole ADC counts (at most an eighth of full scale).
     pub current_offset_a: f64,
@@ -329,6 +344,7 @@ impl Config {
             sliding_mu: mechanism.mu_dynamic,
             backdrive_efficiency: 1.0 / sensors.reducer_efficiency,
             driving_pack: DrivingPack::Relieved,
+            aiding_braking: None,
             current_offset_a: 0.0,
             max_catchup_ticks: 8,
             braking_model_hz: DEFAULT_BRAKING_MODEL_HZ,

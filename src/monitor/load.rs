@@ -249,6 +249,16 @@ impl Load {
         self.estimate.known().is_some() && self.alt.is_none()
     }
 
+    /// The load is known but unseen ([`LoadEstimate::Unseen`]).
+    pub fn unseen(&self) -> bool {
+        matches!(self.estimate, LoadEstimate::Unseen(_))
+    }
+
+    /// An unseen load read another way (`aiding`): known and seen from here on.
+    pub fn seen(&mut self, value: Q16) {
+        self.estimate = LoadEstimate::Known(value);
+    }
+
     /// [`Load::decided`] and seen: an estimate resting on the load may be trusted.
     pub fn trusted(&self) -> bool {
         matches!(self.estimate, LoadEstimate::Known(_)) && self.alt.is_none()

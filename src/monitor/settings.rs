@@ -1,12 +1,13 @@
 //! The monitor's settings: every stage's constants, built once from a [`Config`] by each
 //! stage's builder (in data order), apart from the state the step changes.
 
+use super::aiding::AidingSettings;
 use super::checks::CheckSettings;
 use super::config::{Config, ConfigError};
 use super::convert::{positive, require};
 use super::estimate::EstimateSettings;
 use super::functional_test::TestSettings;
-use super::load::LoadSettings;
+use super::load::{Load, LoadSettings};
 use super::observe::ObserveSettings;
 use super::pack::PackSettings;
 use super::scene::SceneSettings;
@@ -27,6 +28,8 @@ pub struct Settings {
     pub(crate) estimate: EstimateSettings,
     pub(crate) checks: CheckSettings,
     pub(crate) functional_test: TestSettings,
+    /// A spring-only pack's aiding load from its braking, once commissioning identified it.
+    pub(crate) aiding: Option<AidingSettings>,
     /// No estimate is trusted unless the monitor was set for its plant.
     pub(crate) commissioned: bool,
 }
@@ -48,7 +51,21 @@ impl Settings {
             estimate: EstimateSettings::new(c)?,
             checks: CheckSettings::new(c, &pack, &ratios)?,
             functional_test: TestSettings::new(c)?,
+            aiding: AidingSettings::new(c)?,
             commissioned: c.commissioned,
         })
+    }
+}
+
+impl Settings {
+    /// `load`'s cache for its present load (capacity, margin floor, decelerations).
+    pub(crate) fn refresh_load(&self, load: &mut Load) {
+        let value = load.estimate.value();
+        let capacity = self.pack.capacity(self.pack.clamped_force(value));
+        let decel = self
+            .checks
+            .envelope
+            .decelerations(capacity, value, load.alt);
+        load.refresh(&self.load, value, capacity, decel);
     }
 }

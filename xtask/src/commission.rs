@@ -124,6 +124,7 @@ pub fn main(a: &CommissionArgs) -> Result<i32, String> {
                     "braking_time_s": f.braking_time_s,
                     "braking_nm": f.braking_nm,
                     "braking_share": f.braking_share,
+                    "decel_rad_s2": f.decel_rad_s2,
                     "closing": f.closing,
                 })
             })
@@ -138,6 +139,11 @@ pub fn main(a: &CommissionArgs) -> Result<i32, String> {
                 "braking_share": c.braking_share,
                 "sliding_mu": c.config.sliding_mu,
                 "driving_pack": format!("{:?}", c.config.driving_pack),
+                "aiding_braking": c.aiding.map(|b| json!({
+                    "inertia_kg_m2": b.inertia_kg_m2,
+                    "drag_nm": b.drag_nm,
+                    "load_gain": b.load_gain,
+                })),
                 "config_file": text,
             })
         );

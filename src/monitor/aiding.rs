@@ -1,0 +1,203 @@
+//! A load that aids a spring-only pack's motion, read from its braking (a commissioned unit,
+//! docs/monitor-design.md, "Aiding load"). While the drive runs, such a pack overruns on
+//! almost no drive torque whatever the load, so the load is unseen (`LoadEstimate::Unseen`).
+//! Cut, the load clamps the ramps and the pack brakes it: `J·α = D + g·M`, the output
+//! decelerating from `ω₀` over the angle `θ` to the lock, `α = ω₀²/(2θ)`. Commissioning
+//! identifies `J`, `D` and `g` (`AidingBraking`); at the lock the load is `(J·α − D)/g`.
+//!
+//! | step | when | does |
+//! |---|---|---|
+//! | [`Cut::at`] | the drive is cut (a unit with `AidingBraking`) | keeps the observer's speed |
+//! | [`Cut::travel`] | every tick after | sums the output's travel (a braking may pass half a turn) |
+//! | [`Cut::load_at_lock`] | the first lock after it, the load unseen | `M̂` along the motion, if `M̂ ≥ D` |
+//!
+//! Below `D` the ramps need not clamp (the seated pack brakes a lighter load alone), and the
+//! reading is not taken: the load stays unseen and untrusted.
+//!
+//! | quantity | format | range | resolution |
+//! |---|---|---|---|
+//! | `ω₀²` | [`Q16`] rad²/s², saturating | 0 … 32 768 | 1.5e-5 |
+//! | `ω₀²/θ` | `i32` Q24 rad²/s² per count, saturating | 0 … 128 | 6e-8 |
+//! | braking angle | `i32` counts, saturating sum of the ticks' travel | ±2^31 counts | 1 count |
+//! | `J·α`, `M̂` | [`Q16`] N·m, saturating | ±32 768 | 1.5e-5 N·m |
+
+use super::config::{Config, ConfigError};
+use super::convert::{positive, q16, scale};
+use super::load::Load;
+use super::scale::{sat_i32, Scale};
+use super::sense::Sensed;
+use super::{mul_q16, observe::Observed};
+use crate::fx::Q16;
+
+/// The reading's constants (present once commissioning identified them).
+#[cfg_attr(
+    feature = "config-block",
+    derive(serde::Serialize, serde::Deserialize, Hash)
+)]
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) struct AidingSettings {
+    /// `J/(2·rad per count)/256`: `ω₀²/θ` (Q24, per count) → `J·α` (Q16 N·m).
+    torque_per: Scale<27>,
+    /// `D`: the seated pack's braking torque.
+    drag: Q16,
+    /// `1/g`.
+    per_gain: Scale<24>,
+}
+
+impl AidingSettings {
+    /// `None` unless `c.aiding_braking` was identified.
+    pub fn new(c: &Config) -> Result<Option<AidingSettings>, ConfigError> {
+        let Some(a) = c.aiding_braking else {
+            return Ok(None);
+        };
+        let inertia = positive(a.inertia_kg_m2, "aiding_braking.inertia_kg_m2")?;
+        let gain = positive(a.load_gain, "aiding_braking.load_gain")?;
+        Ok(Some(AidingSettings {
+            torque_per: scale(
+                inertia / (2.0 * c.sensors.output_rad_per_count()) / 256.0,
+                "aiding_braking.inertia_kg_m2",
+            )?,
+            drag: q16(
+                positive(a.drag_nm, "aiding_braking.drag_nm")?,
+                "aiding_braking.drag_nm",
+            )?,
+            per_gain: scale(1.0 / gain, "aiding_braking.load_gain")?,
+        }))
+    }
+}
+
+/// Where the drive was cut.
+#[cfg_attr(
+    feature = "config-block",
+    derive(serde::Serialize, serde::Deserialize, Hash)
+)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) struct Cut {
+    w: Q16,
+    /// Output counts since the cut.
+    travel: i32,
+}
+
+impl Cut {
+    /// At the cut: the observer's speed.
+    pub fn at(o: &Observed) -> Cut {
+        Cut { w: o.w, travel: 0 }
+    }
+
+    /// Each tick after the cut: the output's travel.
+    #[inline]
+    pub fn travel(&mut self, x: &Sensed) {
+        self.travel = self.travel.saturating_add(x.d_out);
+    }
+
+    /// The load along the motion (signed as the speed at the cut) that braked the output from
+    /// the cut to the lock, if it clamped the ramps (`M̂ ≥ D`) and the output ended past the
+    /// cut along its motion.
+    pub fn load_at_lock(self, k: &AidingSettings) -> Option<Q16> {
+        let back = self.w < Q16::ZERO;
+        let angle = if back {
+            self.travel.saturating_neg()
+        } else {
+            self.travel
+        };
+        if angle <= 0 {
+            return None;
+        }
+        let w2 = i64::from(mul_q16(self.w, self.w).to_bits()) << 8;
+        let per_count = sat_i32(w2.checked_div(i64::from(angle))?);
+        let decel_torque = Q16::from_bits(k.torque_per.apply(per_count));
+        let load = Q16::from_bits(
+            k.per_gain
+                .apply(decel_torque.saturating_sub(k.drag).to_bits()),
+        );
+        (load >= k.drag).then_some(if back { load.saturating_neg() } else { load })
+    }
+}
+
+/// At a lock: a load `load` holds unseen, read from the braking since `cut` (`k` identified),
+/// becomes known. Returns whether it did.
+pub(crate) fn read_at_lock(cut: Option<Cut>, k: Option<&AidingSettings>, load: &mut Load) -> bool {
+    match cut.zip(k).and_then(|(c, k)| c.load_at_lock(k)) {
+        Some(m) if load.unseen() => {
+            load.seen(m);
+            true
+        }
+        _ => false,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::monitor::config::AidingBraking;
+
+    /// A unit with `J = 0.05`, `D = 8`, `g = 1.5`: an aiding 20 N·m braked from 10 rad/s needs
+    /// `α = (8 + 30)/0.05 = 760` rad/s², over `θ = ω₀²/(2α)`.
+    fn unit() -> (Config, AidingSettings) {
+        let c = Config {
+            aiding_braking: Some(AidingBraking {
+                inertia_kg_m2: 0.05,
+                drag_nm: 8.0,
+                load_gain: 1.5,
+            }),
+            ..Config::default()
+        };
+        let k = AidingSettings::new(&c).ok().flatten().expect("identified");
+        (c, k)
+    }
+
+    /// The load read after braking from `w` over `theta` in steps of at most 0.01 rad.
+    fn lock_after(c: &Config, k: &AidingSettings, w: f64, theta: f64) -> Option<f64> {
+        let counts = (theta / c.sensors.output_rad_per_count()).round() as i32;
+        let mut cut = Cut::at(&Observed {
+            w: Q16::from_num(w),
+            ..Observed::NONE
+        });
+        let (mut left, step) = (counts, 26 * counts.signum());
+        while left != 0 {
+            let d_out = if left.abs() < step.abs() { left } else { step };
+            cut.travel(&Sensed {
+                d_out,
+                ..Sensed::NONE
+            });
+            left -= d_out;
+        }
+        cut.load_at_lock(k).map(|m| m.to_num::<f64>())
+    }
+
+    #[test]
+    fn the_braking_angle_gives_the_load_along_the_motion() {
+        let (c, k) = unit();
+        let theta = 10.0_f64 * 10.0 / (2.0 * 760.0);
+        let m = lock_after(&c, &k, 10.0, theta).expect("clamped");
+        assert!((m - 20.0).abs() < 0.1, "{m}");
+        // Turning the other way: the load is negative.
+        let m = lock_after(&c, &k, -10.0, -theta).expect("clamped");
+        assert!((m + 20.0).abs() < 0.1, "{m}");
+        // A slow braking past half a turn (the counter's aliasing limit): 10 N·m at
+        // J·α = 8 + 1.5·10 = 23 N·m from 20 rad/s takes 1.30 rad; at J = 0.5, 4.35 rad.
+        let mut slow = c;
+        slow.aiding_braking = slow.aiding_braking.map(|a| AidingBraking {
+            inertia_kg_m2: 0.5,
+            ..a
+        });
+        let ks = AidingSettings::new(&slow)
+            .ok()
+            .flatten()
+            .expect("identified");
+        let m = lock_after(&slow, &ks, 20.0, 400.0 / (2.0 * 23.0 / 0.5)).expect("clamped");
+        assert!((m - 10.0).abs() < 0.05, "{m}");
+    }
+
+    #[test]
+    fn a_load_below_the_drag_or_no_braking_angle_is_not_read() {
+        let (c, k) = unit();
+        // 6 N·m would need J·α = 17 < D + g·D: left unseen.
+        let theta = 10.0_f64 * 10.0 / (2.0 * (8.0 + 1.5 * 6.0) / 0.05);
+        assert_eq!(lock_after(&c, &k, 10.0, theta), None);
+        assert_eq!(lock_after(&c, &k, 10.0, 0.0), None);
+        // Back past the cut: no braking along the motion to read.
+        assert_eq!(lock_after(&c, &k, 10.0, -0.05), None);
+        assert!(AidingSettings::new(&Config::default()) == Ok(None));
+    }
+}
