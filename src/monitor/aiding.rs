@@ -30,7 +30,7 @@ use super::sense::Sensed;
 use super::{mul_q16, observe::Observed};
 use crate::fx::Q16;
 
-/// The least `g·M̂/D` at which the reading is trusted: `J·α`'s error (≤ 0.6 % on tuning seed
+/// The least `g·M̂/D` at which the reading is taken: `J·α`'s error (≤ 0.6 % on tuning seed
 /// 1616's forward loads) times `1 + D/(g·M̂)` stays within 2 %.
 pub const CONDITIONING: f64 = 0.4;
 
