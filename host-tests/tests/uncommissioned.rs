@@ -280,6 +280,20 @@ fn a_turn_back_the_pack_keeps_slowing_is_no_slip() {
     assert_quiet(&trace);
 }
 
+/// Tuning seed 6174's run 76667 (paper form, reverse load 29.4 N·m): the pack slips at μ_d only
+/// ≈ 5 % above the load, so the turn-back it clamps slows at ≈ 10 rad/s² from 3.8 rad/s, 1/19 of
+/// its speed per 20 ms window: braking, not a slip (`brake_slip` at 0.23 s while the windows
+/// asked 1/16 and the peak ⅞).
+#[test]
+fn a_turn_back_the_pack_slows_barely_faster_than_the_load_drives_it_is_no_slip() {
+    let (d, trace) = family_draw(6174, 76667);
+    assert!(d.scene.faults.is_empty());
+    let back = turned_back(&trace);
+    let limit = Family::Plant.config().thresholds.creep_limit_rad;
+    assert!(back > 4.0 * limit, "turned back {back:.3} rad");
+    assert_quiet(&trace);
+}
+
 /// Tuning seed 4242's runs 42355 and 66709 (paper form, continuous closing at 8.1 and 8.9 N·m):
 /// the pack holds the door while the ideal speed input turns on at 12.9 rad/s with 0.4 N·m of
 /// drive torque (the sensor's offset). Not counted apart (its output counter ticks now and
