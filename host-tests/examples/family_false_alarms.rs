@@ -1,25 +1,38 @@
 //! Where the uncommissioned monitor false-alarms on the plant family (docs/decisions.md, "The
 //! plant family in the Monte Carlo"): the healthy runs of `monitor-mc --family plant`, per
 //! form and scene kind, with the first flag each raised, the runs that raised it, and whether
-//! the paper reading's pack slips at μ_s.
+//! the paper reading's pack slips at μ_s. Words after `[RUNS] [SEED]` keep only the draws of
+//! those forms and scene kinds (`physical ForwardLoad ContinuousClosing`): a rare class sooner.
 //!
-//! `cargo run --release -p host-tests --example family_false_alarms -- [RUNS] [SEED]` (defaults
-//! 400 and 1616).
+//! `cargo run --release -p host-tests --example family_false_alarms -- [RUNS] [SEED] [WORD …]`
+//! (defaults 400 and 1616).
 
 use host_tests::accuracy::{compare, run_monitor};
-use host_tests::family::{form, runs_and_seed, Family};
+use host_tests::family::{form, ExampleArgs, Family};
 use host_tests::mc::{draw_in, draw_trace, not_driven};
 use std::collections::BTreeMap;
 
 fn main() -> Result<(), String> {
-    let mut args = std::env::args().skip(1);
-    let (runs, seed) = runs_and_seed(&mut args, 400, 1616);
+    let a = ExampleArgs::parse(400, 1616);
+    let (runs, seed) = (a.runs, a.seed);
+    let forms: Vec<&String> = a
+        .rest
+        .iter()
+        .filter(|w| ["paper", "physical"].contains(&w.as_str()))
+        .collect();
+    let kinds: Vec<&String> = a.rest.iter().filter(|w| !forms.contains(w)).collect();
     let mut runs_by: BTreeMap<String, usize> = BTreeMap::new();
     let mut flags_by: BTreeMap<String, Vec<u64>> = BTreeMap::new();
     let (mut apart, mut apart_quiet) = (0, 0);
     for i in 0..runs {
         let d = draw_in(Family::Plant, seed, i, None);
-        let key = format!("{} {:?}", form(&d.scene), d.scene.kind);
+        let kind = format!("{:?}", d.scene.kind);
+        if !(forms.is_empty() || forms.iter().any(|f| *f == form(&d.scene)))
+            || !(kinds.is_empty() || kinds.contains(&&kind))
+        {
+            continue;
+        }
+        let key = format!("{} {kind}", form(&d.scene));
         *runs_by.entry(key.clone()).or_default() += 1;
         let trace = draw_trace(&d)?;
         let acc = compare(&trace, &run_monitor(&trace, Family::Plant.config())?);
@@ -37,7 +50,7 @@ fn main() -> Result<(), String> {
                 .push(i);
         }
     }
-    println!("healthy runs {runs} of seed {seed}, by form and scene kind:");
+    println!("healthy draws 0..{runs} of seed {seed}, run by form and scene kind:");
     for (k, n) in &runs_by {
         println!("{n:6}  {k}");
     }
