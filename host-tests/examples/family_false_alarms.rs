@@ -9,18 +9,25 @@
 
 use host_tests::accuracy::{compare, run_monitor};
 use host_tests::family::{form, ExampleArgs, Family};
-use host_tests::mc::{draw_in, draw_trace, not_driven};
+use host_tests::mc::{draw_in, draw_trace, not_driven, SCENE_KINDS};
 use std::collections::BTreeMap;
 
 fn main() -> Result<(), String> {
     let a = ExampleArgs::parse(400, 1616);
     let (runs, seed) = (a.runs, a.seed);
-    let forms: Vec<&String> = a
+    let (forms, kinds): (Vec<&String>, Vec<&String>) = a
         .rest
         .iter()
-        .filter(|w| ["paper", "physical"].contains(&w.as_str()))
-        .collect();
-    let kinds: Vec<&String> = a.rest.iter().filter(|w| !forms.contains(w)).collect();
+        .partition(|w| ["paper", "physical"].contains(&w.as_str()));
+    if let Some(w) = kinds
+        .iter()
+        .find(|w| !SCENE_KINDS.iter().any(|k| format!("{k:?}") == ***w))
+    {
+        eprintln!(
+            "error: '{w}' is neither a form (paper, physical) nor a scene kind {SCENE_KINDS:?}"
+        );
+        std::process::exit(2)
+    }
     let mut runs_by: BTreeMap<String, usize> = BTreeMap::new();
     let mut flags_by: BTreeMap<String, Vec<u64>> = BTreeMap::new();
     let (mut apart, mut apart_quiet) = (0, 0);

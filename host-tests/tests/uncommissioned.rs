@@ -275,11 +275,11 @@ fn the_servos_settling_after_a_power_on_guess_is_no_lost_gain() {
 #[test]
 fn a_turn_back_the_pack_keeps_slowing_is_no_slip() {
     let limit = Family::Plant.config().thresholds.creep_limit_rad;
-    for (seed, run, limits) in [(4242, 26510, 2.0), (6174, 76667, 4.0)] {
+    for (seed, run, times) in [(4242, 26510, 2.0), (6174, 76667, 4.0)] {
         let (d, trace) = family_draw(seed, run);
         assert!(d.scene.faults.is_empty());
         let back = turned_back(&trace);
-        assert!(back > limits * limit, "run {run} turned back {back:.3} rad");
+        assert!(back > times * limit, "run {run} turned back {back:.3} rad");
         assert_quiet(&trace);
     }
 }

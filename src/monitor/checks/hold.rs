@@ -18,6 +18,12 @@ use crate::monitor::schedule::SLOW;
 /// window this long (at least an exponential decay of 0.64 s: the travel left stays bounded).
 const SLOWING_WINDOW_S: f64 = 0.02;
 
+/// A turn-back is decelerating once |ω̂| is below its peak by `2^-DECELERATING_SHIFT` (1/32).
+const DECELERATING_SHIFT: u32 = 5;
+
+/// A window slowed if |ω̂| fell by `2^-SLOWING_SHIFT` (1/32) of the last window's.
+const SLOWING_SHIFT: u32 = 5;
+
 /// The held brake's constants.
 #[cfg_attr(
     feature = "config-block",
@@ -125,7 +131,10 @@ impl HoldChecks {
         let span = self.creep_max.saturating_sub(self.creep_min);
         // Past the creep limit: slipped unless braking.
         let slipped = span > k.creep_counts
-            && (w.saturating_abs() >= self.peak_speed.saturating_sub(self.peak_speed >> 5)
+            && (w.saturating_abs()
+                >= self
+                    .peak_speed
+                    .saturating_sub(self.peak_speed >> DECELERATING_SHIFT)
                 || (span > k.creep_counts.saturating_mul(2) && !self.slowing));
         if slipped {
             self.creep_valid = false;
@@ -142,7 +151,10 @@ impl HoldChecks {
         if self.window_ticks >= k.slowing_ticks {
             self.window_ticks = 0;
             self.slowing = speed < k.stopped_speed
-                || speed <= self.window_speed.saturating_sub(self.window_speed >> 5);
+                || speed
+                    <= self
+                        .window_speed
+                        .saturating_sub(self.window_speed >> SLOWING_SHIFT);
             self.window_speed = speed;
         }
     }
