@@ -363,6 +363,10 @@ impl Monitor {
             settle_ticks: k.scene.engage_settle_ticks,
             input_speed: st.sense.input_speed(),
             stick_speed: k.scene.stick_speed,
+            command_shortfall: x.command_code.filter(|_| slot == Slot::Checks).map(|code| {
+                k.observe
+                    .motoring_torque(k.checks.command.shortfall(x.current, code))
+            }),
         };
         let (raised, gave_way) =
             st.checks

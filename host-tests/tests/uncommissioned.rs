@@ -8,7 +8,9 @@
 //! (docs/decisions.md). A plant whose input comes apart from its output (the paper
 //! reading's closing at loads up to 8 N·m) is not healthy: the monitor must flag it.
 
-use host_tests::accuracy::{compare, detection_latency_s, run_monitor, scene_trace, Accuracy};
+use host_tests::accuracy::{
+    compare, detection_latency_s, run_monitor, run_monitor_with, scene_trace, Accuracy,
+};
 use host_tests::family::Family;
 use host_tests::mc::{draw_in, draw_trace, not_driven, Draw};
 use noback::monitor::{Config, Thresholds};
@@ -281,6 +283,21 @@ fn a_turn_back_the_pack_keeps_slowing_is_no_slip() {
         let back = turned_back(&trace);
         assert!(back > times * limit, "run {run} turned back {back:.3} rad");
         assert_quiet(&trace);
+    }
+}
+
+/// Tuning seed 4711's runs 74912 and 132810 (physical forward loads of 11.9 and 7.5 N·m): the
+/// monitor powers on into an overrunning chatter and seeds the step check's floor on a pulse or
+/// the servo's settling; the quiet spells then read as a lost gain (`sensor_fault` at 0.11 s).
+/// Given the drive's current command, which falls with the reading, they raise nothing.
+#[test]
+fn a_power_on_into_a_chatter_is_no_lost_gain_given_the_command() {
+    for run in [74912, 132810] {
+        let (_, trace) = counted_draw(4711, run);
+        assert_raises(&trace, Family::Plant.config(), "sensor_fault");
+        let with = run_monitor_with(&trace, Family::Plant.config(), true).expect("monitor");
+        let acc = compare(&trace, &with);
+        assert!(acc.flags.is_empty(), "run {run}: {:?}", acc.flag_times());
     }
 }
 

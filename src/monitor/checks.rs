@@ -93,6 +93,9 @@ pub(crate) struct CheckInputs {
     /// The input shaft's filtered speed and the band within which a shaft stands.
     pub input_speed: Q16,
     pub stick_speed: Q16,
+    /// On the `Checks` slot with the command in the inputs: how far the reading falls short of
+    /// it, as motoring drive torque (N·m).
+    pub command_shortfall: Option<Q16>,
 }
 
 /// The checks' state.
@@ -246,6 +249,7 @@ impl Checks {
                     guessed: c.guessed,
                     ticks: x.n,
                     settle_ticks: i.settle_ticks,
+                    command_shortfall: i.command_shortfall,
                 };
                 raised = raised.union(self.drive.run(&k.drive, &t));
             } else {

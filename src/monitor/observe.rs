@@ -109,6 +109,12 @@ impl ObserveSettings {
             )?,
         })
     }
+
+    /// Drive torque of `counts` of current while motoring (the command's shortfall).
+    #[inline]
+    pub(crate) fn motoring_torque(&self, counts: i32) -> Q16 {
+        Q16::from_bits(self.drive_motoring.apply(counts))
+    }
 }
 
 /// What the observer stage hands on.

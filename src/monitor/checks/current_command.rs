@@ -16,6 +16,7 @@
 //! |---|---|---|---|
 //! | command, reading | `i32` ADC counts about zero current | ±2^15 | 1 count |
 //! | sums over a block | `i32` counts | 16 × 2^15 | 1 count |
+//! | shortfall of the reading against the command | `i32` counts, exact | ±2^17 | 1 count |
 //! | tolerance | `i64` product with `S_c` in Q16 | exact | 1.5e-5 |
 
 use crate::monitor::config::{Config, ConfigError};
@@ -44,6 +45,18 @@ pub(crate) struct CommandSettings {
 }
 
 impl CommandSettings {
+    /// How far the reading `current` falls short of the command `command_code` along the
+    /// command (counts; negative when it reads more). Both are below 2^16: no overflow.
+    #[inline]
+    pub fn shortfall(&self, current: i32, command_code: u16) -> i32 {
+        let c = i32::from(command_code) - self.zero_code;
+        if c < 0 {
+            current - c
+        } else {
+            c - current
+        }
+    }
+
     pub fn new(c: &Config) -> Result<CommandSettings, ConfigError> {
         let t = &c.thresholds;
         let tol = finite(

@@ -10,7 +10,7 @@
 //!
 //! | quantity | format | range | resolution |
 //! |---|---|---|---|
-//! | implied load, drive torque, their histories, the drive torque's floor | [`Q16`], saturating | ±32 768 N·m | 1.5e-5 N·m |
+//! | implied load, drive torque, the command shortfall, their histories, the drive torque's floor | [`Q16`], saturating | ±32 768 N·m | 1.5e-5 N·m |
 //! | persistence counters | `u32` ticks, saturating | — | 1 tick |
 
 use crate::fx::{lowpass, Gain, Q16};
@@ -126,6 +126,8 @@ pub(crate) struct DriveChecks {
     step_ref: Q16,
     /// Recent history (the same low-pass) of the drive torque along the motion.
     drive_ref: Q16,
+    /// Recent history (the same low-pass) of the reading's shortfall against the command.
+    shortfall_ref: Q16,
     /// Its floor: falls as the history does, rises 16× slower, so that the quiet spells of an
     /// overrunning chatter are no lighter step against the pulses between them.
     drive_floor: Q16,
@@ -173,6 +175,8 @@ pub(crate) struct DriveTick {
     pub ticks: u32,
     /// The observer's settling after a change of the pack's reading (`engage_settle_s`).
     pub settle_ticks: u32,
+    /// How far the reading falls short of the drive's command (N·m), when the inputs carry it.
+    pub command_shortfall: Option<Q16>,
 }
 
 impl DriveChecks {
@@ -214,21 +218,9 @@ impl DriveChecks {
     pub fn run(&mut self, p: &DriveSettings, t: &DriveTick) -> Flags {
         let mut flags = Flags::default();
         let counted = SLOW.covered(t.ticks);
-        // Steps of the drive's work: the load the current implies (the observer's net torque
-        // `J_s·ω̇ − u` with the pack model of the scene: drive drag, or the overrunning
-        // equilibrium), along the motion, against its recent history (a low-pass at
-        // `step_reference_hz`). A pack that starts to drag makes the drive push harder; a
-        // current reading that loses gain makes it seem to push less. Both are steps; a genuine
-        // load moves slower than the history follows, and accelerating the output is no step
-        // (the observer's net torque carries `J_s·ω̇`). Along the motion, `s·M` falls when the
-        // drive pushes harder while it carries the load, and rises while overrunning
-        // (`M = y(v) − v` grows with `v`, by `g₁ − 1` per N·m: the limit is scaled so that
-        // both readings allow the same step of drive torque). The history starts once the drive
-        // has run steadily (the output with the input shaft) for the observer's settling time:
-        // the caller runs the checks only then and disarms them otherwise. After a change of
-        // reading it is seeded afresh once the new phase has settled (`engage_settle_s`, 20 ms,
-        // when the caller runs the checks again): the observer needs no longer, since the
-        // monitor hands the modelled pack torque's step to it bumplessly.
+        // Steps of the drive's work: the load the current implies along the motion (net torque
+        // with the scene's pack model; the limit scaled by `g₁ − 1` when overrunning) against its
+        // 5 Hz history, seeded once the phase has settled (docs/monitor-design.md, "Drive checks").
         let along = t.dir.apply(t.net.saturating_add(t.dir.apply(t.pack)));
         if self.step_ref_valid {
             let dev = along.saturating_sub(self.step_ref);
@@ -246,14 +238,9 @@ impl DriveChecks {
             } else {
                 (dev < p.step_limit.saturating_neg(), dev > p.step_limit)
             };
-            // Both faults move the current itself: a drag makes the drive push harder
-            // (the speed loop answers the extra pack torque), a reading that loses gain
-            // reads lower. The mechanism's own torque swings — the pack engaging and
-            // letting go while overrunning, tens of N·m for tens of ms with the speed held
-            // within a rad/s — move the implied load through `J_s·ω̇` and leave the
-            // current alone. So the drive torque must have stepped the same way by half the
-            // allowance and by half the implied load's step (a current step moves the implied
-            // load by the full step, at most `g₁ − 1` times it with the ramps engaged).
+            // Both faults move the current; the pack's own swings move the implied load through
+            // `J_s·ω̇` alone. So the drive torque must step the same way by half the allowance and
+            // half the implied load's step (÷ `g₁ − 1` with the ramps engaged).
             let dev_abs = dev.saturating_abs().to_bits();
             let share = Q16::from_bits(if t.engaged {
                 p.step_share_overrun.apply(dev_abs)
@@ -266,14 +253,22 @@ impl DriveChecks {
             // A history seeded on a guess (a power-on into a running drive) may hold the
             // servo's settling: no lighter step until it has followed for its time constant.
             self.guess_wait_ticks = self.guess_wait_ticks.saturating_sub(counted);
+            // With the command in the inputs, a lighter step is a lost gain only if the reading
+            // fell short of the command too (by half the step asked): a drive that truly works
+            // less moves its command with its current.
+            let short_of_command = t.command_shortfall.is_none_or(|s| {
+                s.saturating_sub(self.shortfall_ref) > Q16::from_bits(needed.to_bits() >> 1)
+            });
             let (harder, lighter) = (
                 harder && drive_step > needed,
-                lighter && below_floor < needed.saturating_neg() && self.guess_wait_ticks == 0,
+                lighter
+                    && below_floor < needed.saturating_neg()
+                    && self.guess_wait_ticks == 0
+                    && short_of_command,
             );
-            // The harder half waits out a pending change towards overrunning (the light-load
-            // chatter of continuous closing pulses the drive torque by 9 N·m and makes the
-            // overrunning reading possible on each pulse), not one away from it (a drag under
-            // the overrunning reading pushes its load past the envelope).
+            // The harder half waits out a pending change towards overrunning (continuous closing's
+            // chatter makes that reading possible on each 9 N·m pulse), not one away from it (a
+            // drag under the overrunning reading pushes its load past the envelope).
             self.step_up_ticks = if harder && (!t.pending || t.engaged) {
                 self.step_up_ticks.saturating_add(counted)
             } else {
@@ -297,6 +292,9 @@ impl DriveChecks {
                 // 6.2 Hz corner against 5 Hz): the direction of a step needs no more, and it is
                 // cheaper than the multiply on the drive checks' tick, the drive's worst.
                 self.drive_ref = follow(self.drive_ref, t.drive, p.drive_ref_shift);
+                if let Some(s) = t.command_shortfall {
+                    self.shortfall_ref = follow(self.shortfall_ref, s, p.drive_ref_shift);
+                }
                 let floor_shift = if t.drive > self.drive_floor {
                     p.drive_ref_shift.saturating_add(FLOOR_RISE_SLOWER).min(31)
                 } else {
@@ -308,6 +306,7 @@ impl DriveChecks {
             self.step_ref = along;
             self.drive_ref = t.drive;
             self.drive_floor = t.drive;
+            self.shortfall_ref = t.command_shortfall.unwrap_or(Q16::ZERO);
             self.step_ref_valid = true;
             self.guess_wait_ticks = if t.guessed { p.history_ticks } else { 0 };
         }
@@ -375,6 +374,7 @@ mod tests {
             guessed: false,
             ticks: 1,
             settle_ticks: settings().scene.engage_settle_ticks,
+            command_shortfall: None,
         }
     }
 
@@ -429,6 +429,22 @@ mod tests {
         let mut c = DriveChecks::default();
         run(&mut c, &carrying(20.0, false), 20);
         assert!(run(&mut c, &carrying(15.0, false), 26).sensor_fault);
+    }
+
+    #[test]
+    fn with_the_command_a_lighter_step_is_a_lost_gain_only_if_the_reading_falls_short_of_it() {
+        // 20 → 15 N·m read: the command falling with the reading (a drive that works less, its
+        // shortfall 0.1 N·m as before) is no fault; the command held (shortfall 5 N·m) is.
+        let read = |drive, short: f64| DriveTick {
+            command_shortfall: Some(Q16::from_num(short)),
+            ..carrying(drive, false)
+        };
+        let mut c = DriveChecks::default();
+        run(&mut c, &read(20.0, 0.1), 100);
+        assert_eq!(run(&mut c, &read(15.0, 0.1), 100), Flags::default());
+        let mut c = DriveChecks::default();
+        run(&mut c, &read(20.0, 0.1), 100);
+        assert!(run(&mut c, &read(15.0, 5.1), 26).sensor_fault);
     }
 
     #[test]

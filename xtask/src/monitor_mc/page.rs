@@ -74,6 +74,18 @@ pub fn false_alarm_line(r: &Value) -> String {
     )
 }
 
+/// The same runs with the drive's current command in the inputs, if the record has them.
+fn command_line(r: &Value) -> String {
+    let fa = &r["false_alarm_rate_with_command"];
+    match fa["of"][0].as_u64() {
+        Some(n) => format!(
+            " With the drive's current command in the inputs: {n} (95 % upper bound {} per run).",
+            sci(&fa["ci95"][1])
+        ),
+        None => String::new(),
+    }
+}
+
 /// Per plant form (a record of the plant family), each form's false alarms with their bound.
 fn form_lines(r: &Value) -> String {
     let Some(forms) = r["by_form"].as_object() else {
@@ -303,12 +315,13 @@ fn campaign_section(record: Option<&Value>) -> String {
     format!(
         "Seed {} ({seed_note}), plant family `{}`, monitor \
          configuration digest {}{stale}. Planned: {planned} nominal runs in {shards} shards on this \
-         machine; {done}:\n\n```sh\n{}\n```\n\n{}\n{}",
+         machine; {done}:\n\n```sh\n{}\n```\n\n{}{}\n{}",
         c["seed"],
         c["plant_family"].as_str().unwrap_or(""),
         c["config_digest"].as_str().unwrap_or(""),
         campaign_command(runs),
         false_alarm_line(c),
+        command_line(c),
         form_lines(c),
     )
 }
