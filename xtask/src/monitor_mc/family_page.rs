@@ -124,6 +124,12 @@ fn table(s: &mut String, seed: u64, what: &str, unc: &Value, com: &Value) {
         let k = format!("{kind:?}");
         row(&k, &|v| cell(&v["detection"][k.as_str()]));
     }
+    row("with the drive's current command: false alarms", &|v| {
+        alarm_cell(&v["false_alarm_with_command"])
+    });
+    row("with the drive's current command: CurrentOpen", &|v| {
+        cell(&v["detection_with_command"]["CurrentOpen"])
+    });
     row(
         "**nominal braking runs** (reverse_load, forward_load) ending locked",
         &|_| String::new(),
@@ -200,6 +206,9 @@ pub fn main(a: &FamilyArgs) -> Result<(), String> {
          in monitor.md; and how many of them ended with the estimate marked trusted, and \
          trusted while its holding torque was more than 2 % off (issue 16's item 2: an \
          estimate the monitor cannot stand behind is marked untrusted).\n\
+         - Rows *with the drive's current command*: the same runs with the command in the \
+         monitor's inputs (`Inputs::current_command_code`, monitor-design.md); every other row \
+         is without it.\n\
          - Seed {TUNING_SEED} is where the plant family's thresholds were chosen; seed \
          {EVALUATION_SEED} was never tuned on. Commissioning's rules were not chosen on \
          either.",
@@ -241,9 +250,16 @@ mod tests {
         let mut s = String::new();
         table(&mut s, 11, "test", &unc, &com);
         let rows: Vec<&str> = s.lines().filter(|l| l.starts_with("| ")).collect();
-        // Header, false alarms, each kind, the braking block (title and seven rows), refused,
-        // not driven.
-        assert_eq!(rows.len(), 1 + 1 + FAULT_KINDS.len() + 8 + 2, "{s}");
+        // Header, false alarms, each kind, the two with the command, the braking block (title
+        // and seven rows), refused, not driven.
+        assert_eq!(rows.len(), 1 + 1 + FAULT_KINDS.len() + 2 + 8 + 2, "{s}");
+        for form in FORMS {
+            let fa = &unc[form]["false_alarm_with_command"]["of"];
+            assert_eq!(
+                fa[1], unc[form]["false_alarm"]["of"][1],
+                "{form}: the same runs"
+            );
+        }
         assert!(rows.iter().all(|r| r.matches(" | ").count() >= 4), "{s}");
     }
 }

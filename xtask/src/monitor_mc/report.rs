@@ -242,17 +242,27 @@ pub fn by_form(outcomes: &[Outcome], forms: &[&str], commissioned: bool) -> Valu
             .collect();
         let nominal: Vec<&&Outcome> = mine.iter().filter(|o| o.counts_as_nominal()).collect();
         let false_alarms = nominal.iter().filter(|o| o.false_flags > 0).count();
-        let mut detection = serde_json::Map::new();
+        let false_alarms_with_command = nominal
+            .iter()
+            .filter(|o| o.false_flags_with_command > 0)
+            .count();
+        let (mut detection, mut detection_with_command) =
+            (serde_json::Map::new(), serde_json::Map::new());
         for kind in FAULT_KINDS {
             let manifested: Vec<&&Outcome> = mine
                 .iter()
                 .filter(|o| o.fault == Some(kind) && o.error.is_none() && o.manifested)
                 .collect();
-            let hits = manifested.iter().filter(|o| detected(o)).count();
-            detection.insert(format!("{kind:?}"), rate(hits, manifested.len()));
+            let hits = |d: fn(&Outcome) -> bool| manifested.iter().filter(|o| d(o)).count();
+            let name = format!("{kind:?}");
+            detection.insert(name.clone(), rate(hits(detected), manifested.len()));
+            detection_with_command
+                .insert(name, rate(hits(detected_with_command), manifested.len()));
         }
         let mut v = json!({
             "false_alarm": rate(false_alarms, nominal.len()),
+            "false_alarm_with_command": rate(false_alarms_with_command, nominal.len()),
+            "detection_with_command": detection_with_command,
             "errors": mine.iter().filter(|o| o.error.is_some()).count(),
             "not_driven": mine.iter().filter(|o| o.not_driven).count(),
             "detection": detection,
