@@ -3,6 +3,7 @@
 
 use host_tests::accuracy::scene_trace;
 use noback::monitor::{Config, Inputs, Monitor, SnapshotError};
+use noback::trip_log::record::MAGIC;
 use noback_twin::scene::Scene;
 
 fn inputs(r: &noback_twin::trace::TraceRow) -> Inputs {
@@ -48,5 +49,22 @@ fn a_short_buffer_or_corrupt_bytes_are_refused() {
     assert_eq!(
         Monitor::restore(Config::default(), &buf[..n / 2]).unwrap_err(),
         SnapshotError::Corrupt
+    );
+}
+
+/// A fresh monitor's saved state, its length and FNV-1a: a change here is a change of the
+/// state's layout, which must also change the trip record's magic, or a record of the old
+/// layout would restore into a wrong state.
+#[test]
+fn the_fresh_state_is_the_one_recorded_with_the_record_magic() {
+    let m = Monitor::new(Config::default()).unwrap();
+    let mut buf = [0_u8; 4096];
+    let bytes = m.save_state(&mut buf).unwrap();
+    let mut d = noback::digest::Fnv1a::new();
+    bytes.iter().for_each(|b| d.push_byte(*b));
+    assert_eq!(
+        (MAGIC, bytes.len(), d.value()),
+        (*b"NBT2", 259, 0x057B_FD63),
+        "the record's magic, the fresh state's length and digest"
     );
 }
