@@ -286,9 +286,9 @@ fn a_turn_back_the_pack_keeps_slowing_is_no_slip() {
     }
 }
 
-/// Tuning seed 4711's runs 74912 and 132810 (physical forward loads of 11.9 and 7.5 N·m): the
-/// monitor powers on into an overrunning chatter and seeds the step check's floor on a pulse or
-/// the servo's settling; the quiet spells then read as a lost gain (`sensor_fault` at 0.11 s).
+/// Tuning seed 4711's runs 74912 and 132810 (physical forward loads of 7.5 and 11.9 N·m): the
+/// monitor powers on into an overrunning chatter and seeds the step check's floor on a pulse
+/// (74912) or the servo's settling (132810); the quiet spells then read as a lost gain.
 /// Given the drive's current command, which falls with the reading, they raise nothing.
 #[test]
 fn a_power_on_into_a_chatter_is_no_lost_gain_given_the_command() {
