@@ -45,11 +45,17 @@ pub(crate) struct CommandSettings {
 }
 
 impl CommandSettings {
+    /// The command's code as counts about zero current (|c| < 2^16).
+    #[inline]
+    fn counts(&self, command_code: u16) -> i32 {
+        i32::from(command_code) - self.zero_code
+    }
+
     /// How far the reading `current` falls short of the command `command_code` along the
     /// command (counts; negative when it reads more). Both are below 2^16: no overflow.
     #[inline]
     pub fn shortfall(&self, current: i32, command_code: u16) -> i32 {
-        let c = i32::from(command_code) - self.zero_code;
+        let c = self.counts(command_code);
         if c < 0 {
             current - c
         } else {
@@ -109,7 +115,7 @@ impl CommandCheck {
         if k.tolerance_q16 == 0 {
             return false;
         }
-        let c = i32::from(command_code) - k.zero_code;
+        let c = k.counts(command_code);
         if c.saturating_abs() >= k.floor {
             // |c|, |current| < 2^16 and 16 samples: the sums cannot overflow.
             self.command_sum = self.command_sum.saturating_add(c.saturating_abs());
