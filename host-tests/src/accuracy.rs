@@ -406,11 +406,44 @@ pub fn manifest_time(fault: &Fault, trace: &Trace) -> Option<f64> {
     }
 }
 
+/// Whether a fault weakens the hold (its manifesting is read from the drive-off slips).
+pub fn is_holding(kind: FaultKind) -> bool {
+    matches!(
+        kind,
+        FaultKind::FrictionLoss
+            | FaultKind::SpringBroken
+            | FaultKind::PackWear
+            | FaultKind::RampJam
+    )
+}
+
+/// [`manifest_time`] beside the same run without the fault (`healthy`: same scene and noise):
+/// a holding fault shows only once its output has also left the healthy output by more than
+/// [`HELD_RATTLE_RAD`]; until then the encoders show what a healthy pack shows (the paper
+/// reading's own braking turns its output back by up to 0.5 rad and then locks).
+pub fn manifest_time_beside(fault: &Fault, trace: &Trace, healthy: &Trace) -> Option<f64> {
+    let at = manifest_time(fault, trace)?;
+    if !is_holding(fault.kind) {
+        return Some(at);
+    }
+    trace
+        .rows
+        .iter()
+        .zip(&healthy.rows)
+        .filter(|(r, h)| r.t_s >= at && (r.t_s - h.t_s).abs() < 1e-9)
+        .find(|(r, h)| (r.output_angle_rad - h.output_angle_rad).abs() > HELD_RATTLE_RAD)
+        .map(|(r, _)| r.t_s)
+}
+
 /// Detection latency of a fault (s): from its manifesting to the first flag that answers its
 /// kind raised at or after the onset (0 when the flag came first: detected before it could
 /// harm). `None`: never flagged, or never manifest.
 pub fn detection_latency_s(fault: &Fault, trace: &Trace, acc: &Accuracy) -> Option<f64> {
-    let at = manifest_time(fault, trace)?;
+    latency_after(manifest_time(fault, trace)?, fault, acc)
+}
+
+/// [`detection_latency_s`] from a manifesting time found otherwise ([`manifest_time_beside`]).
+pub fn latency_after(at: f64, fault: &Fault, acc: &Accuracy) -> Option<f64> {
     acc.flags
         .iter()
         .filter(|f| expected_flag(fault.kind).contains(&f.flag))
@@ -498,5 +531,35 @@ mod tests {
             (if open { 0.05 } else { 0.0 }, if open { 0 } else { 2 })
         });
         assert_eq!(manifest_time(&fault(FaultKind::SpringBroken), &t), None);
+    }
+
+    /// An output that slips back 0.3 rad from 0.05 s at 10 rad/s (slipping), then locks.
+    fn turn_back(extra_rad: f64) -> Trace {
+        let travel = 0.3 + extra_rad;
+        trace(3000, move |t| {
+            let moved = (10.0 * (t - 0.05)).clamp(0.0, travel);
+            (moved, if t > 0.05 && moved < travel { 1 } else { 2 })
+        })
+    }
+
+    #[test]
+    fn a_holding_fault_that_turns_the_output_back_only_as_far_as_a_healthy_pack_is_dormant() {
+        // On the trace alone the 0.3 rad slip is a failing hold; beside the healthy run (the
+        // same slip, 0.05 rad shorter) it never leaves the held rattle.
+        let f = fault(FaultKind::PackWear);
+        assert!(manifest_time(&f, &turn_back(0.05)).is_some());
+        assert_eq!(
+            manifest_time_beside(&f, &turn_back(0.05), &turn_back(0.0)),
+            None
+        );
+    }
+
+    #[test]
+    fn a_holding_fault_manifests_where_its_output_leaves_the_healthy_one() {
+        // 0.2 rad further than the healthy slip: 0.13 rad beyond it 13 ms after the healthy
+        // one locked at 0.08 s.
+        let f = fault(FaultKind::PackWear);
+        let at = manifest_time_beside(&f, &turn_back(0.2), &turn_back(0.0)).expect("manifests");
+        assert!((at - 0.0931).abs() < 2e-4, "{at}");
     }
 }

@@ -7,7 +7,8 @@ use crate::replay::trace_of;
 use crate::shell::workspace_root;
 use host_tests::accuracy::run_functional_test;
 use host_tests::accuracy::{
-    compare, detection_latency_s, false_alarms, manifest_time, run_monitor, COMPARE_WINDOW_S,
+    compare, false_alarms, is_holding, latency_after, manifest_time, manifest_time_beside,
+    run_monitor, scene_trace, COMPARE_WINDOW_S,
 };
 use noback::monitor::Config;
 use noback_twin::scene::{Scene, SceneKind};
@@ -95,14 +96,27 @@ pub fn main(a: &MonitorArgs) -> Result<i32, String> {
         None => None,
     };
 
+    // A holding fault manifests where the scene leaves the same scene without its faults.
+    let healthy = match scene.as_ref() {
+        Some(s) if faults.iter().any(|f| is_holding(f.kind)) => {
+            let mut s = s.clone();
+            s.faults.clear();
+            Some(scene_trace(&s)?)
+        }
+        _ => None,
+    };
     let detections: Vec<_> = faults
         .iter()
         .map(|f| {
+            let at = match &healthy {
+                Some(h) => manifest_time_beside(f, &trace, h),
+                None => manifest_time(f, &trace),
+            };
             json!({
                 "kind": format!("{:?}", f.kind),
                 "at_s": f.at_s,
-                "manifests_at_s": manifest_time(f, &trace),
-                "detection_latency_s": detection_latency_s(f, &trace, &acc),
+                "manifests_at_s": at,
+                "detection_latency_s": at.and_then(|at| latency_after(at, f, &acc)),
             })
         })
         .collect();

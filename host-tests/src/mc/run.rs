@@ -3,7 +3,10 @@
 //! draw over the machine's cores.
 
 use super::{draw_trace_after, not_driven, Context, Draw, Outcome, PRE_ROLL_S};
-use crate::accuracy::{compare, detection_latency_s, manifest_time, run_monitor, run_monitor_with};
+use crate::accuracy::{
+    compare, is_holding, latency_after, manifest_time, manifest_time_beside, run_monitor,
+    run_monitor_with,
+};
 use crate::dormant::functional_test_after;
 use crate::family::Family;
 use noback::monitor::Config;
@@ -78,7 +81,20 @@ pub fn evaluate(d: &Draw, campaign: &Campaign) -> Outcome {
         Err(e) => return fail(e),
     };
     let onset = fault.map_or(f64::INFINITY, |f| f.at_s);
-    let manifested = fault.is_some_and(|f| manifest_time(&f, &trace).is_some());
+    // A holding fault manifests only where its run leaves the same run without it.
+    let manifest = match fault {
+        Some(f) if is_holding(f.kind) => {
+            let mut healthy = d.clone();
+            healthy.scene.faults.clear();
+            match draw_trace_after(&healthy, campaign.pre_roll_s) {
+                Ok(same) => manifest_time_beside(&f, &trace, &same),
+                Err(e) => return fail(e),
+            }
+        }
+        Some(f) => manifest_time(&f, &trace),
+        None => None,
+    };
+    let manifested = manifest.is_some();
     let not_driven = fault.is_none() && not_driven(&trace, &d.scene.sensors);
     let every = campaign.test_every;
     let tested = every > 0
@@ -96,8 +112,12 @@ pub fn evaluate(d: &Draw, campaign: &Campaign) -> Outcome {
     };
     Outcome {
         fault: fault.map(|f| f.kind),
-        latency_s: fault.and_then(|f| detection_latency_s(&f, &trace, &acc)),
-        latency_with_command_s: fault.and_then(|f| detection_latency_s(&f, &trace, &with_command)),
+        latency_s: fault
+            .zip(manifest)
+            .and_then(|(f, at)| latency_after(at, &f, &acc)),
+        latency_with_command_s: fault
+            .zip(manifest)
+            .and_then(|(f, at)| latency_after(at, &f, &with_command)),
         manifested,
         context: fault.map(|f| Context::of(f.at_s, &trace, d.scene.kind, &config)),
         false_flags: acc.flags.iter().filter(|f| f.t_s < onset).count(),

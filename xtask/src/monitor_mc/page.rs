@@ -2,7 +2,9 @@
 //! campaign sizes the intervals ask for, the certification-scale nominal campaign's bound).
 
 use super::report::{context_name, DETECTION_TARGET};
-use host_tests::accuracy::{COMPARE_WINDOW_S, FAILED_HOLD_SLIP_S, HELD_RATTLE_RAD};
+use host_tests::accuracy::{
+    COMPARE_WINDOW_S, FAILED_HOLD_SLIP_S, HELD_RATTLE_RAD, VISIBLE_CURRENT_A,
+};
 use host_tests::mc::{checks_armed_s, Context, DETECTION_WINDOW_S, PRE_ROLL_S};
 use host_tests::stats::{trials_for_width, trials_for_zero_events_below};
 use noback::monitor::Config;
@@ -357,13 +359,17 @@ pub fn doc(r: &Value, record: Option<&Value>) -> String {
          or fault kind, run index) (`host_tests::mc::run_rng`): a campaign cut into shards \
          (`--shard K/N --out part-K.json`, then `monitor-mc merge part-*.json`, or the Slurm \
          job array in `slurm/`) gives this page byte for byte.\n\
-         - *Manifesting* (`host_tests::accuracy::manifest_time`, from the twin's truth): a \
-         holding fault (friction_loss, spring_broken, pack_wear, ramp_jam) when, with the drive \
+         - *Manifesting* (`host_tests::accuracy::manifest_time_beside`, from the twin's truth): \
+         a holding fault (friction_loss, spring_broken, pack_wear, ramp_jam) when, with the drive \
          off, the pack does not hold — slips, or stays open — for {slip:.0} ms (a healthy pack locks \
          within 2–11 ms) and the output turns more than {rattle:.2} rad meanwhile: the brake is \
          failing to hold, from the moment the output passes that turn (inside it, the rattle of \
-         a held output in its lost motion, the encoders show what a held output shows); drag \
-         and current_open when the drive next runs; encoder_jump at its onset; encoder_stuck \
+         a held output in its lost motion, the encoders show what a held output shows) and has \
+         also left the output of the same run without the fault (same scene and noise) by more \
+         than {rattle:.2} rad (before that the encoders show what a healthy pack shows: the paper \
+         reading's own braking turns its output back by up to 0.5 rad, then locks); drag when \
+         the drive next runs; current_open when it next runs at {visible:.1} A or more (below that a lost \
+         gain hides in the sensor's offset and noise); encoder_jump at its onset; encoder_stuck \
          once the true output has left the frozen reading by more than {rattle:.2} rad (inside \
          it the frozen reading is what a held output rattling in its lost motion shows, and no \
          other sensor sees the output there). A fault that never \
@@ -414,6 +420,7 @@ pub fn doc(r: &Value, record: Option<&Value>) -> String {
         campaign = campaign_section(record),
         sizes = campaign_sizes(r),
         rattle = HELD_RATTLE_RAD,
+        visible = VISIBLE_CURRENT_A,
         pre_roll = PRE_ROLL_S * 1e3,
     )
 }
