@@ -246,9 +246,17 @@ pub fn by_form(outcomes: &[Outcome], forms: &[&str], commissioned: bool) -> Valu
             .iter()
             .filter(|o| o.false_flags_with_command > 0)
             .count();
-        let (mut detection, mut detection_with_command) =
-            (serde_json::Map::new(), serde_json::Map::new());
+        let (mut detection, mut detection_with_command, mut dormant) = (
+            serde_json::Map::new(),
+            serde_json::Map::new(),
+            serde_json::Map::new(),
+        );
         for kind in FAULT_KINDS {
+            let never = mine
+                .iter()
+                .filter(|o| o.fault == Some(kind) && o.error.is_none() && !o.manifested)
+                .count();
+            dormant.insert(format!("{kind:?}"), json!(never));
             let manifested: Vec<&&Outcome> = mine
                 .iter()
                 .filter(|o| o.fault == Some(kind) && o.error.is_none() && o.manifested)
@@ -266,6 +274,7 @@ pub fn by_form(outcomes: &[Outcome], forms: &[&str], commissioned: bool) -> Valu
             "errors": mine.iter().filter(|o| o.error.is_some()).count(),
             "not_driven": mine.iter().filter(|o| o.not_driven).count(),
             "detection": detection,
+            "dormant": dormant,
         });
         if commissioned {
             v["commissioning_refused"] = json!(mine.iter().filter(|o| o.refused).count());

@@ -1,6 +1,6 @@
 //! A campaign cut into 2 or 3 shards, each run on a different number of threads and merged in
 //! any order, gives the unsharded campaign's report and page byte for byte; merge refuses parts
-//! that do not belong together.
+//! that do not belong together; the per-form report counts each kind's dormant runs.
 
 use super::*;
 
@@ -189,4 +189,31 @@ fn merge_refuses_parts_that_do_not_belong_together() {
         part::merge(&[("a".into(), a)], true).map(|(c, _)| c.runs),
         Ok(4)
     );
+}
+
+#[test]
+fn a_fault_run_that_never_manifests_counts_as_dormant_in_its_form_only() {
+    use host_tests::mc::Outcome;
+    use noback_twin::fault::FaultKind;
+    let kind = Some(FaultKind::PackWear);
+    let manifested = Outcome {
+        manifested: true,
+        ..Outcome::quiet(kind)
+    };
+    let failed = Outcome {
+        error: Some("twin".into()),
+        ..Outcome::quiet(kind)
+    };
+    let outcomes = [
+        manifested,
+        Outcome::quiet(kind),
+        failed,
+        Outcome::quiet(kind),
+    ];
+    let forms = ["paper", "paper", "paper", "physical"];
+    let v = super::report::by_form(&outcomes, &forms, false);
+    assert_eq!(v["paper"]["dormant"]["PackWear"], 1);
+    assert_eq!(v["paper"]["detection"]["PackWear"]["of"][1], 1);
+    assert_eq!(v["physical"]["dormant"]["PackWear"], 1);
+    assert_eq!(v["physical"]["dormant"]["Drag"], 0);
 }
