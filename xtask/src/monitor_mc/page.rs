@@ -367,7 +367,8 @@ pub fn doc(r: &Value, record: Option<&Value>) -> String {
          a held output in its lost motion, the encoders show what a held output shows) and has \
          also left the output of the same run without the fault (same scene and noise) by more \
          than {rattle:.2} rad (before that the encoders show what a healthy pack shows: the paper \
-         reading's own braking turns its output back by up to 0.5 rad, then locks); drag when \
+         reading's own braking lets its output run on, turn back and slip for tens of ms before it \
+         locks); drag when \
          the drive next runs; current_open when it next runs at {visible:.1} A or more (below that a lost \
          gain hides in the sensor's offset and noise); encoder_jump at its onset; encoder_stuck \
          once the true output has left the frozen reading by more than {rattle:.2} rad (inside \
