@@ -406,24 +406,13 @@ pub fn manifest_time(fault: &Fault, trace: &Trace) -> Option<f64> {
     }
 }
 
-/// Whether a fault weakens the hold (its manifesting is read from the drive-off slips).
-pub fn is_holding(kind: FaultKind) -> bool {
-    matches!(
-        kind,
-        FaultKind::FrictionLoss
-            | FaultKind::SpringBroken
-            | FaultKind::PackWear
-            | FaultKind::RampJam
-    )
-}
-
 /// [`manifest_time`] beside the same run without the fault (`healthy`: same scene and noise):
 /// a holding fault shows only once its output has also left the healthy output by more than
 /// [`HELD_RATTLE_RAD`]; until then the encoders show what a healthy pack shows (the paper
 /// reading's own braking lets its output run on, turn back and slip before it locks).
 pub fn manifest_time_beside(fault: &Fault, trace: &Trace, healthy: &Trace) -> Option<f64> {
     let at = manifest_time(fault, trace)?;
-    if !is_holding(fault.kind) {
+    if !fault.kind.is_holding() {
         return Some(at);
     }
     trace

@@ -48,6 +48,17 @@ impl FaultKind {
         })
     }
 
+    /// True for faults that weaken the hold (they show, if at all, in the drive-off slips).
+    pub fn is_holding(self) -> bool {
+        matches!(
+            self,
+            FaultKind::FrictionLoss
+                | FaultKind::SpringBroken
+                | FaultKind::PackWear
+                | FaultKind::RampJam
+        )
+    }
+
     /// True for faults of the sensors (they leave the physics alone).
     pub fn is_sensor(self) -> bool {
         matches!(

@@ -7,8 +7,8 @@ use crate::replay::trace_of;
 use crate::shell::workspace_root;
 use host_tests::accuracy::run_functional_test;
 use host_tests::accuracy::{
-    compare, false_alarms, is_holding, latency_after, manifest_time, manifest_time_beside,
-    run_monitor, scene_trace, COMPARE_WINDOW_S,
+    compare, false_alarms, latency_after, manifest_time, manifest_time_beside, run_monitor,
+    scene_trace, COMPARE_WINDOW_S,
 };
 use noback::monitor::Config;
 use noback_twin::scene::{Scene, SceneKind};
@@ -98,7 +98,7 @@ pub fn main(a: &MonitorArgs) -> Result<i32, String> {
 
     // A holding fault manifests where the scene leaves the same scene without its faults.
     let healthy = match scene.as_ref() {
-        Some(s) if faults.iter().any(|f| is_holding(f.kind)) => {
+        Some(s) if faults.iter().any(|f| f.kind.is_holding()) => {
             let mut s = s.clone();
             s.faults.clear();
             Some(scene_trace(&s)?)

@@ -4,8 +4,7 @@
 
 use super::{draw_trace_after, not_driven, Context, Draw, Outcome, PRE_ROLL_S};
 use crate::accuracy::{
-    compare, is_holding, latency_after, manifest_time, manifest_time_beside, run_monitor,
-    run_monitor_with,
+    compare, latency_after, manifest_time, manifest_time_beside, run_monitor, run_monitor_with,
 };
 use crate::dormant::functional_test_after;
 use crate::family::Family;
@@ -83,7 +82,7 @@ pub fn evaluate(d: &Draw, campaign: &Campaign) -> Outcome {
     let onset = fault.map_or(f64::INFINITY, |f| f.at_s);
     // A holding fault manifests only where its run leaves the same run without it.
     let manifest = match fault {
-        Some(f) if is_holding(f.kind) => {
+        Some(f) if f.kind.is_holding() => {
             let mut healthy = d.clone();
             healthy.scene.faults.clear();
             match draw_trace_after(&healthy, campaign.pre_roll_s) {

@@ -252,20 +252,18 @@ pub fn by_form(outcomes: &[Outcome], forms: &[&str], commissioned: bool) -> Valu
             serde_json::Map::new(),
         );
         for kind in FAULT_KINDS {
-            let never = mine
+            let (manifested, never): (Vec<&&Outcome>, Vec<&&Outcome>) = mine
                 .iter()
-                .filter(|o| o.fault == Some(kind) && o.error.is_none() && !o.manifested)
-                .count();
-            dormant.insert(format!("{kind:?}"), json!(never));
-            let manifested: Vec<&&Outcome> = mine
-                .iter()
-                .filter(|o| o.fault == Some(kind) && o.error.is_none() && o.manifested)
-                .collect();
+                .filter(|o| o.fault == Some(kind) && o.error.is_none())
+                .partition(|o| o.manifested);
             let hits = |d: fn(&Outcome) -> bool| manifested.iter().filter(|o| d(o)).count();
             let name = format!("{kind:?}");
             detection.insert(name.clone(), rate(hits(detected), manifested.len()));
-            detection_with_command
-                .insert(name, rate(hits(detected_with_command), manifested.len()));
+            detection_with_command.insert(
+                name.clone(),
+                rate(hits(detected_with_command), manifested.len()),
+            );
+            dormant.insert(name, json!(never.len()));
         }
         let mut v = json!({
             "false_alarm": rate(false_alarms, nominal.len()),
