@@ -27,14 +27,14 @@ pub struct SensorConfig {
     pub motor_counter_bits: u8,
 }
 
-/// Defaults from MODEL.md: 0.06 N·m/A, ratio 30 at 0.9, 12-bit ADC over ±25 A,
+/// Defaults from MODEL.md: 0.06 N·m/A, ratio 30 at 0.9, 12-bit ADC over ±30 A,
 /// 4096 counts/rev motor encoder in a 16-bit counter, 14-bit output encoder.
 pub const DEFAULT_SENSORS: SensorConfig = SensorConfig {
     motor_torque_constant_nm_a: 0.06,
     reducer_ratio: 30.0,
     reducer_efficiency: 0.9,
     current_adc_bits: 12,
-    current_full_scale_a: 25.0,
+    current_full_scale_a: 30.0,
     motor_encoder_counts_per_rev: 4096,
     output_encoder_bits: 14,
     motor_counter_bits: 16,
@@ -83,7 +83,7 @@ mod tests {
     #[test]
     fn defaults_give_the_expected_resolutions() {
         let s = DEFAULT_SENSORS;
-        assert!((s.amps_per_count() - 50.0 / 4096.0).abs() < 1e-15);
+        assert!((s.amps_per_count() - 60.0 / 4096.0).abs() < 1e-15);
         // One motor count is 2π/(4096·30) rad at the input shaft: 51 µrad.
         assert!((s.input_rad_per_motor_count() - 5.113e-5).abs() < 1e-8);
         assert!((s.output_rad_per_count() - 3.835e-4).abs() < 1e-7);

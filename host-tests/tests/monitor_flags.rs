@@ -67,12 +67,12 @@ fn adc_stuck_at_a_rail_is_a_sensor_fault_but_a_single_rail_sample_is_not() {
 fn current_with_the_drive_off_is_implausible() {
     let mut m = Monitor::new(Config::physical_reading()).unwrap();
     at_rest(&mut m, 0, 0, 100);
-    // 5 A with the drive off (3 A allowed): 5/(50/4096) ≈ 410 counts.
-    let e = m.step(&Inputs::new(MID + 410, 0, 0, false));
+    // 5 A with the drive off (3 A allowed): 5/(60/4096) ≈ 341 counts.
+    let e = m.step(&Inputs::new(MID + 341, 0, 0, false));
     assert!(e.flags.sensor_fault);
     let mut m = Monitor::new(Config::physical_reading()).unwrap();
     at_rest(&mut m, 0, 0, 100);
-    let e = m.step(&Inputs::new(MID + 200, 0, 0, false)); // 2.4 A: within the allowance
+    let e = m.step(&Inputs::new(MID + 164, 0, 0, false)); // 2.4 A: within the allowance
     assert!(!e.flags.sensor_fault);
 }
 
@@ -201,7 +201,7 @@ fn very_late_step_reseats_the_observer_and_is_untrusted() {
 #[test]
 fn missed_ticks_while_moving_keep_tracking() {
     // 4 output counts per tick (15.3 rad/s), every fourth call covers two ticks. The drive
-    // carries ≈ 3 N·m (150 ADC counts): a moving no-back's drive always carries some, and a
+    // carries ≈ 3.6 N·m (150 ADC counts): a moving no-back's drive always carries some, and a
     // reading of zero while the output turns is a dead current sensor (`sensor_fault`).
     let code = MID + 150;
     let mut m = Monitor::new(Config::physical_reading()).unwrap();

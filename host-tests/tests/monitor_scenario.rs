@@ -109,7 +109,7 @@ impl Plant {
         for _ in 0..SUBSTEPS {
             match drive {
                 Some(w_ref) => {
-                    // Ideal servo: the speed follows the reference with at most 50 rad/s² (within the drive's 25 A).
+                    // Ideal servo: the speed follows the reference with at most 50 rad/s² (within the drive's 25 A limit).
                     let dw = (w_ref - self.omega).clamp(-50.0 * dt, 50.0 * dt);
                     let w_new = self.omega + dw;
                     let s = if w_new > 0.0 {

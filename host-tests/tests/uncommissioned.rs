@@ -2,7 +2,8 @@
 //! the healthy built-in scenes of both readings over the door's load range, and the settings
 //! set for the physical reading differ from it only where the family needs wider ones.
 //!
-//! Loads span the Monte Carlo's 5–30 N·m. Above capacity/1.5 the margin is below the limit by
+//! Loads span the Monte Carlo's 5–30 N·m (a drive stalled at its current limit: to the scene
+//! schema's 500 N·m). Above capacity/1.5 the margin is below the limit by
 //! definition (`brake_weak` is the right answer); below 5 N·m the paper reading's drag while
 //! driving (3.7–7.8 N·m against the model's 1.98) leaves the reading ambiguous uncommissioned
 //! (docs/decisions.md). A plant whose input comes apart from its output (the paper
@@ -110,6 +111,55 @@ fn healthy_scenes_of_both_readings_raise_nothing_uncommissioned() {
         not_moving <= 1,
         "{not_moving} plants that do not move (paper closing at 5 N·m)"
     );
+}
+
+#[test]
+fn a_drive_stalled_at_its_current_limit_reads_below_the_rail_and_raises_nothing() {
+    // Loads to the scene schema's 500 N·m: the physical drive stalls at its 25 A limit, which
+    // reads below the ±30 A sensor's rail; the paper reading's drive has no limit and clips.
+    for (reading, kind, load) in [
+        (Reading::Physical, SceneKind::Drive, 60.0),
+        (Reading::Physical, SceneKind::ReverseLoad, 150.0),
+        (Reading::Physical, SceneKind::ForwardLoad, 500.0),
+        (Reading::Physical, SceneKind::ContinuousClosing, 500.0),
+        (Reading::Paper, SceneKind::Drive, 500.0),
+    ] {
+        let mut scene = Scene::builtin(kind, reading);
+        scene.load_torque_nm = load;
+        let trace = scene_trace(&scene).expect("twin");
+        let s = &scene.sensors;
+        let limit = f64::from(1_u32 << (s.current_adc_bits - 1)) * scene.open.drive_current_limit_a
+            / s.current_full_scale_a;
+        let peak = trace
+            .rows
+            .iter()
+            .map(|r| {
+                (f64::from(r.current_code) - f64::from(1_u32 << (s.current_adc_bits - 1))).abs()
+            })
+            .fold(0.0, f64::max);
+        let rail = f64::from((1_u32 << (s.current_adc_bits - 1)) - 1);
+        match reading {
+            Reading::Physical => assert!(
+                peak > 0.95 * limit && peak < rail,
+                "{kind:?} {load}: peak {peak} counts, limit {limit}, rail {rail}"
+            ),
+            Reading::Paper => assert!(peak >= rail, "{kind:?} {load}: peak {peak}"),
+        }
+        let acc = monitor(&trace, Config::default());
+        assert!(
+            acc.flags.is_empty(),
+            "{reading:?} {kind:?} {load}: {:?}",
+            acc.flag_times()
+        );
+        // A load the stall hides is not reported as a confident holding torque.
+        if let Some((twin, est)) = acc.holding_torque_nm {
+            let off = (est - twin).abs() > 0.02 * twin.abs();
+            assert!(
+                !(off && acc.trusted_at_end),
+                "{kind:?} {load}: {est} vs {twin}, trusted"
+            );
+        }
+    }
 }
 
 #[test]

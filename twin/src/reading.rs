@@ -43,6 +43,9 @@ pub struct OpenItems {
     /// Proportional gain of the physical reading's motor speed servo, at the input shaft
     /// (N·m per rad/s).
     pub drive_gain_nm_s_rad: f64,
+    /// The physical reading's drive current limit (A); below the current sensor's full scale,
+    /// as drives size their sensing, so a drive at its limit reads below the ADC's rail.
+    pub drive_current_limit_a: f64,
     /// Motor inertia reflected to the input shaft (kg·m²); not in Table 2.
     pub reflected_motor_inertia_kg_m2: f64,
     /// Speed (rad/s) over which bearing friction torques reach their Coulomb value (tanh).
@@ -68,6 +71,7 @@ pub struct OpenItems {
 pub const DEFAULT_OPEN: OpenItems = OpenItems {
     approach_speed_floor_m_s: 0.01,
     drive_gain_nm_s_rad: 50.0,
+    drive_current_limit_a: 25.0,
     reflected_motor_inertia_kg_m2: 0.0,
     bearing_smoothing_rad_s: 0.01,
     axial_smoothing_m_s: 1e-4,

@@ -131,6 +131,7 @@ struct RawSensors {
 struct RawOpen {
     approach_speed_floor_m_s: Option<f64>,
     drive_gain_nm_s_rad: Option<f64>,
+    drive_current_limit_a: Option<f64>,
     reflected_motor_inertia_kg_m2: Option<f64>,
     bearing_smoothing_rad_s: Option<f64>,
     axial_smoothing_m_s: Option<f64>,
@@ -421,6 +422,13 @@ impl RawFile {
             "open.drive_gain_nm_s_rad",
             1e-3,
             1e5,
+        )?;
+        ranged(
+            &mut o.drive_current_limit_a,
+            ro.drive_current_limit_a,
+            "open.drive_current_limit_a",
+            1e-3,
+            1e3,
         )?;
         ranged(
             &mut o.reflected_motor_inertia_kg_m2,

@@ -1,5 +1,6 @@
 //! `cargo xtask monitor SCENE|SCENE.toml|TRACE.csv [--config FILE] [--json] [--out DIR]` — the monitor against
-//! the twin on one scene (or on a recorded trace): accuracy figures, flags, detection latency per injected fault, false alarms, and a
+//! the twin on one scene (or on a recorded trace): accuracy figures, flags, detection latency per injected fault, false alarms
+//! (none counted where the input comes apart from the output: an unhealthy plant), and a
 //! plot with the twin's raw and compared signals beside the monitor's estimate.
 //! The comparison itself lives in `host_tests::accuracy` (this file only runs and reports).
 
@@ -8,11 +9,15 @@ use crate::shell::workspace_root;
 use host_tests::accuracy::run_functional_test;
 use host_tests::accuracy::{
     compare, false_alarms, latency_after, manifest_time, manifest_time_beside, run_monitor,
-    scene_trace, COMPARE_WINDOW_S,
+    scene_trace, Accuracy, COMPARE_WINDOW_S,
 };
+use host_tests::mc::not_driven;
 use noback::monitor::Config;
+use noback::sensors::SensorConfig;
+use noback_twin::fault::Fault;
 use noback_twin::scene::{Scene, SceneKind};
 use noback_twin::svg::{render, Panel, Series};
+use noback_twin::trace::Trace;
 
 use noback_twin::args::bad_input;
 #[cfg(test)]
@@ -70,6 +75,18 @@ fn functional_test_json(
     }))
 }
 
+/// Whether the run's input came apart from its output, and its false alarms where it did not:
+/// such a plant is not healthy (the Monte Carlo counts it apart), so its flags are not false.
+fn counted_alarms(
+    trace: &Trace,
+    sensors: &SensorConfig,
+    faults: &[Fault],
+    acc: &Accuracy,
+) -> (bool, Option<usize>) {
+    let apart = not_driven(trace, sensors);
+    (apart, (!apart).then(|| false_alarms(faults, acc)))
+}
+
 pub fn main(a: &MonitorArgs) -> Result<i32, String> {
     let (target, json_out, out) = (a.target.clone(), a.json, a.out.clone());
     // A trace file (the twin's CSV format) is replayed as it is; anything else is a scene (the
@@ -88,6 +105,8 @@ pub fn main(a: &MonitorArgs) -> Result<i32, String> {
     };
     let estimates = run_monitor(&trace, config)?;
     let acc = compare(&trace, &estimates);
+    let sensors = scene.as_ref().map_or(config.sensors, |s| s.sensors);
+    let (apart, false_alarms) = counted_alarms(&trace, &sensors, &faults, &acc);
     let functional_test = match scene
         .as_ref()
         .filter(|s| s.kind == SceneKind::FunctionalTest)
@@ -140,7 +159,8 @@ pub fn main(a: &MonitorArgs) -> Result<i32, String> {
         "lock_time_err_s": acc.lock_time_err_s().filter(|e| e.is_finite()),
         "flags": flags,
         "detection_latency_s": detections,
-        "false_alarms": false_alarms(&faults, &acc),
+        "input_apart_from_output": apart,
+        "false_alarms": false_alarms,
         "functional_test": functional_test,
         "config": a.config.as_ref().map_or("uncommissioned".into(), |p| p.display().to_string()),
     });
@@ -220,6 +240,30 @@ mod tests {
         let path = dir.join(name);
         std::fs::write(&path, text).unwrap();
         path.to_string_lossy().into_owned()
+    }
+
+    #[test]
+    fn a_plant_whose_input_comes_apart_counts_no_false_alarm_and_a_stall_counts_its_flags() {
+        use noback_twin::reading::Reading;
+        // The paper reading's closing at 2 N·m: the input runs on while the output stands
+        // (flagged, not counted); the physical drive stalled at 60 N·m: counted, none.
+        for (kind, reading, load, want) in [
+            (SceneKind::ForwardLoad, Reading::Paper, 2.0, (true, None)),
+            (SceneKind::Drive, Reading::Physical, 60.0, (false, Some(0))),
+        ] {
+            let mut scene = Scene::builtin(kind, reading);
+            scene.load_torque_nm = load;
+            let trace = scene_trace(&scene).unwrap();
+            let acc = compare(&trace, &run_monitor(&trace, Config::default()).unwrap());
+            assert_eq!(
+                acc.flags.is_empty(),
+                !want.0,
+                "{kind:?} {:?}",
+                acc.flag_times()
+            );
+            let got = counted_alarms(&trace, &scene.sensors, &scene.faults, &acc);
+            assert_eq!(got, want, "{kind:?} {load}");
+        }
     }
 
     #[test]

@@ -139,7 +139,7 @@ impl CommandCheck {
 mod tests {
     use super::*;
 
-    /// Default sensors: 12 bits, mid-scale 2048, 25 A full scale (≈ 82 counts per A).
+    /// Default sensors: 12 bits, mid-scale 2048, 30 A full scale (≈ 68 counts per A).
     fn settings() -> CommandSettings {
         CommandSettings::new(&Config::default()).unwrap()
     }
@@ -176,7 +176,7 @@ mod tests {
         let k = settings();
         assert!(
             !block(&k, 100, 0.0, 0),
-            "2.5 A floor ≈ 205 counts: 100 is below"
+            "2.5 A floor ≈ 171 counts: 100 is below"
         );
         let off = CommandSettings {
             tolerance_q16: 0,

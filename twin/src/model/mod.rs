@@ -44,10 +44,10 @@ pub struct ModelConfig {
 }
 
 impl ModelConfig {
-    /// Largest input-shaft torque the motor can give: full-scale current through the reducer.
+    /// Largest input-shaft torque the motor can give: its current limit through the reducer.
     pub fn drive_torque_limit_nm(&self) -> f64 {
         self.sensors
-            .input_torque_nm(self.sensors.current_full_scale_a)
+            .input_torque_nm(self.open.drive_current_limit_a)
             .abs()
     }
 }
