@@ -128,22 +128,26 @@ fn a_drive_stalled_at_its_current_limit_reads_below_the_rail_and_raises_nothing(
         scene.load_torque_nm = load;
         let trace = scene_trace(&scene).expect("twin");
         let s = &scene.sensors;
-        let limit = f64::from(1_u32 << (s.current_adc_bits - 1)) * scene.open.drive_current_limit_a
-            / s.current_full_scale_a;
-        let peak = trace
+        let (mid, max_code) = (
+            1_i32 << (s.current_adc_bits - 1),
+            (1_u16 << s.current_adc_bits) - 1,
+        );
+        let at_rail = trace
             .rows
             .iter()
-            .map(|r| {
-                (f64::from(r.current_code) - f64::from(1_u32 << (s.current_adc_bits - 1))).abs()
-            })
+            .any(|r| r.current_code == 0 || r.current_code >= max_code);
+        let peak_a = trace
+            .rows
+            .iter()
+            .map(|r| f64::from((i32::from(r.current_code) - mid).abs()) * s.amps_per_count())
             .fold(0.0, f64::max);
-        let rail = f64::from((1_u32 << (s.current_adc_bits - 1)) - 1);
+        let limit_a = scene.open.drive_current_limit_a;
         match reading {
             Reading::Physical => assert!(
-                peak > 0.95 * limit && peak < rail,
-                "{kind:?} {load}: peak {peak} counts, limit {limit}, rail {rail}"
+                peak_a > 0.95 * limit_a && !at_rail,
+                "{kind:?} {load}: peak {peak_a} A, limit {limit_a} A, at the rail {at_rail}"
             ),
-            Reading::Paper => assert!(peak >= rail, "{kind:?} {load}: peak {peak}"),
+            Reading::Paper => assert!(at_rail, "{kind:?} {load}: peak {peak_a} A"),
         }
         let acc = monitor(&trace, Config::default());
         assert!(

@@ -106,7 +106,7 @@ pub fn main(a: &MonitorArgs) -> Result<i32, String> {
     let estimates = run_monitor(&trace, config)?;
     let acc = compare(&trace, &estimates);
     let sensors = scene.as_ref().map_or(config.sensors, |s| s.sensors);
-    let (apart, false_alarms) = counted_alarms(&trace, &sensors, &faults, &acc);
+    let (apart, counted) = counted_alarms(&trace, &sensors, &faults, &acc);
     let functional_test = match scene
         .as_ref()
         .filter(|s| s.kind == SceneKind::FunctionalTest)
@@ -160,7 +160,7 @@ pub fn main(a: &MonitorArgs) -> Result<i32, String> {
         "flags": flags,
         "detection_latency_s": detections,
         "input_apart_from_output": apart,
-        "false_alarms": false_alarms,
+        "false_alarms": counted,
         "functional_test": functional_test,
         "config": a.config.as_ref().map_or("uncommissioned".into(), |p| p.display().to_string()),
     });
