@@ -8,7 +8,7 @@
 //! |---|---|---|
 //! | current offset | the current reading over the final hold, drive off | `current_offset_a` |
 //! | current gain (two runs or more, loads ≥ 5 N·m apart) | slope of the steady drive torque over the load | `sensors.motor_torque_constant_nm_a` |
-//! | pack drag while driving | steady drive torque / gain − the load | `sliding_mu` (spring-only, or no closing run) |
+//! | pack drag while driving | steady drive torque / gain − the load | `driving_drag_nm`; `sliding_mu` (spring-only, or no closing run) |
 //! | overrunning equilibrium (a closing run) | `y = L + v` against `g₁(μ)·v − g₀(μ)` | `sliding_mu` (relieved) |
 //! | braking against the load | the output's deceleration to its turning point: `J·α − M` | `braking_share` (0.8 × its share of the capacity) |
 //! | a spring-only pack's braking (two opening loads and a closing) | the decelerations `ω₀²/(2θ)`: openings `J·α = M + D`, the closing `J·α = D + g·M` | `aiding_braking` |
@@ -344,7 +344,7 @@ pub fn commission(runs: &[(&Trace, f64)]) -> Result<Commissioning, String> {
     let aiding = (!relieved)
         .then(|| aiding_braking(&opening, closing?, base.mechanism.output_inertia_kg_m2))
         .flatten();
-    let mut config = configured(base, a, braking_share, relieved);
+    let mut config = configured(base, a, drag, braking_share, relieved);
     config.aiding_braking = aiding;
     // The monitor's torque per amp, so that its drive torque reads true.
     config.sensors.motor_torque_constant_nm_a /= gain;
@@ -390,9 +390,11 @@ fn aiding_braking(opening: &[&RunFigures], closing: &RunFigures, j: f64) -> Opti
 
 /// The configuration for a pack with `a = μ·c` while slipping, whose measured braking against the
 /// load is `share` of its capacity, and which the ramps clamp from the cut (`relieved`) or not.
-fn configured(base: Config, a: f64, share: f64, relieved: bool) -> Config {
+fn configured(base: Config, a: f64, drag: f64, share: f64, relieved: bool) -> Config {
     let mut cfg = base;
     cfg.sliding_mu = a / base.mechanism.pack_torque_per_newton_m(1.0);
+    // The drag the openings measured, not `a`'s: a closing run's `a` gives another drag.
+    cfg.driving_drag_nm = Some(drag);
     cfg.driving_pack = if relieved {
         DrivingPack::Relieved
     } else {
@@ -407,9 +409,7 @@ fn configured(base: Config, a: f64, share: f64, relieved: bool) -> Config {
     cfg.thresholds.braking_angle_factor = t.braking_angle_factor;
     cfg.thresholds.opposed_braking_share = (share * BRAKING_SHARE_MARGIN).clamp(0.0, 1.0);
     // The dead-reading check needs a drive torque that never falls near zero while the output
-    // turns: a relieved pack's drag (a·F_s/(1 + a·k)); a spring-only pack closes on almost none.
-    let m = &base.mechanism;
-    let drag = a * m.spring_preload_n() / (1.0 + a * m.ramp_factor_per_m());
+    // turns: a relieved pack's drag; a spring-only pack closes on almost none.
     cfg.thresholds.dead_current_nm = if relieved {
         (drag / 4.0).min(t.dead_current_nm)
     } else {

@@ -9,6 +9,7 @@
 //! sliding_mu = 0.12
 //! driving_pack = "spring_only"   # or "relieved" (the default)
 //! current_offset_a = 0.05        # the current reading at zero current
+//! driving_drag_nm = 1.4          # the pack's drag while driving (absent: the model's)
 //! motor_torque_constant_nm_a = 0.066
 //! [monitor.thresholds]
 //! opposed_braking_share = 1.0
@@ -166,6 +167,9 @@ pub fn parse(text: &str) -> Result<Config, String> {
             *field = number(&v, &format!("monitor.{key}"))?;
         }
     }
+    if let Some(v) = m.remove("driving_drag_nm") {
+        c.driving_drag_nm = Some(number(&v, "monitor.driving_drag_nm")?);
+    }
     match m.remove("driving_pack") {
         None => {}
         Some(Value::String(s)) if s == "relieved" => c.driving_pack = DrivingPack::Relieved,
@@ -204,6 +208,9 @@ pub fn write(c: &Config, comment: &str) -> Result<String, String> {
         ),
     ] {
         out.push_str(&format!("{key} = {v:?}\n"));
+    }
+    if let Some(d) = c.driving_drag_nm {
+        out.push_str(&format!("driving_drag_nm = {d:?}\n"));
     }
     let pack = match c.driving_pack {
         DrivingPack::Relieved => "relieved",

@@ -330,6 +330,20 @@ fn constructor_rejects_out_of_range_parameters() {
             parameter: "sliding_mu"
         }
     );
+    // A measured driving drag: positive, and no more than μ = 2 gives on the spring alone.
+    for drag in [0.0, -1.0, f64::NAN, 200.0] {
+        let c = Config {
+            driving_drag_nm: Some(drag),
+            ..Config::physical_reading()
+        };
+        let parameter = "driving_drag_nm";
+        let expected = if drag.is_nan() {
+            ConfigError::NotFinite { parameter }
+        } else {
+            ConfigError::OutOfRange { parameter }
+        };
+        assert_eq!(err(c), expected, "{drag}");
+    }
     let mut c = Config::physical_reading();
     c.sensors.output_encoder_bits = 30;
     assert_eq!(

@@ -302,6 +302,9 @@ pub struct Config {
     pub backdrive_efficiency: f64,
     /// How the pack is pressed while driving against the load (its force and drag then).
     pub driving_pack: DrivingPack,
+    /// The pack's drag while the drive carries the load (N·m at the output), measured at
+    /// commissioning; `None`: the model's, `μ_d·c` times the driving force of `driving_pack`.
+    pub driving_drag_nm: Option<f64>,
     /// A spring-only pack's braking of an aiding load, once identified (else `None`).
     pub aiding_braking: Option<AidingBraking>,
     /// The phase-current reading at zero current (A), measured at commissioning with the drive
@@ -344,6 +347,7 @@ impl Config {
             sliding_mu: mechanism.mu_dynamic,
             backdrive_efficiency: 1.0 / sensors.reducer_efficiency,
             driving_pack: DrivingPack::Relieved,
+            driving_drag_nm: None,
             aiding_braking: None,
             current_offset_a: 0.0,
             max_catchup_ticks: 8,

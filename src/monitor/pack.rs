@@ -6,7 +6,7 @@
 //! | `spring_force` | `F_s`, the spring preload (N) | 169.2 N |
 //! | `ramp_factor` | `k = tanθ/r`: N of pressing force per N·m through the ramps | 50 /m |
 //! | `capacity_per_n` | `μ_s·c`: capacity per N of pressing force (m) | 0.0498 m |
-//! | `drive_force`, `drive_drag` | `F_s/(1 + a·k)` (`F_s` with `DrivingPack::SpringOnly`) and `a·F` while the drive carries the load | 70 N, 1.98 N·m |
+//! | `drive_force`, `drive_drag` | `F_s/(1 + a·k)` (`F_s` with `DrivingPack::SpringOnly`) and `a·F` (or the commissioned `driving_drag_nm`) while the drive carries the load | 70 N, 1.98 N·m |
 //! | `overrun_gain`, `overrun_offset` | `y = g₁·v − g₀`, the pack torque while overrunning | 6.86, 11.6 N·m |
 
 use super::config::{Config, ConfigError, DrivingPack};
@@ -106,19 +106,30 @@ impl PackSettings {
             DrivingPack::Relieved => spring / (1.0 + a_k),
             DrivingPack::SpringOnly => spring,
         };
+        // A measured drag stands for the model's: at most what `sliding_mu`'s bound (μ = 2)
+        // gives on the spring alone.
+        let drive_drag = match c.driving_drag_nm {
+            Some(d) => {
+                let d = finite(d, "driving_drag_nm")?;
+                let most = m.pack_torque_per_newton_m(2.0) * spring;
+                require(d > 0.0 && d <= most, "driving_drag_nm")?;
+                d
+            }
+            None => a * drive_force,
+        };
         let settings = PackSettings {
             spring_force: q16(spring, "mechanism.spring_preload_m")?,
             ramp_factor: scale(ramp, "mechanism.socket_radius_m")?,
             capacity_per_n: scale(per_n, "capacity_mu")?,
             drive_force: q16(drive_force, "sliding_mu")?,
-            drive_drag: q16(a * drive_force, "sliding_mu")?,
+            drive_drag: q16(drive_drag, "sliding_mu")?,
             overrun_gain: scale(2.0 * a_k / (a_k - 1.0), "sliding_mu")?,
             overrun_offset: q16(a * spring / (a_k - 1.0), "sliding_mu")?,
             spring_only: c.driving_pack == DrivingPack::SpringOnly,
         };
         let ratios = PackRatios {
             a_k,
-            drive_drag_nm: a * drive_force,
+            drive_drag_nm: drive_drag,
         };
         Ok((settings, ratios))
     }
