@@ -8,18 +8,22 @@
 //! overruns, flags with times, estimate against the twin at key moments, instructions per step,
 //! flash, RAM, stack, and whether the firmware's estimates equal the host's bit for bit.
 
-use crate::cores::{Core, Firmware};
-use crate::qemu::BOOT_TIMEOUT;
-use crate::qemu::{self, Boot, Outcome};
+use crate::cores::Core;
 use crate::replay::{host_run, host_run_tested, nbr1, stress_trace, twin_trace, STRESS};
-use crate::shell::{self, cargo, workspace_root};
+use crate::shell::workspace_root;
 use crate::{bootstrap, elf_size};
 use noback::monitor::config_block::{self, CONFIG_BLOCK_BYTES};
 use noback::monitor::functional_test::TestConfig;
-use noback::monitor::{Config, Flags};
+use noback::monitor::Config;
 use noback_twin::scene::SceneKind;
 use serde_json::json;
-use std::collections::BTreeMap;
+
+mod image;
+mod log_lines;
+
+pub use image::{boot, build, build_bin, build_package_bin};
+use log_lines::hex;
+pub use log_lines::{background_insns, field, fields, flag_names, line_with, step_insns};
 
 /// In the stress run the operator "resets" the flags this often (ticks), so they keep changing.
 pub const STRESS_RESET_EVERY: u32 = 50;
@@ -73,55 +77,6 @@ pub fn write_replay(
     let replay_path = dir.join(format!("{stem}.nbr1"));
     std::fs::write(&replay_path, &bytes).map_err(|e| e.to_string())?;
     Ok((dir, stem, replay_path, bytes))
-}
-
-/// `key=value` fields of a decoded log line.
-pub fn fields(line: &str) -> BTreeMap<&str, &str> {
-    line.split_whitespace()
-        .filter_map(|token| token.split_once('='))
-        .collect()
-}
-
-pub fn field<T: std::str::FromStr>(line: &BTreeMap<&str, &str>, key: &str) -> Result<T, String> {
-    let raw = line
-        .get(key)
-        .ok_or_else(|| format!("no `{key}=` in the firmware's line"))?;
-    let raw = raw.trim_start_matches("0x");
-    raw.parse()
-        .or_else(|_| {
-            u64::from_str_radix(raw, 16)
-                .map_err(|_| ())
-                .and_then(|v| v.to_string().parse().map_err(|_| ()))
-        })
-        .map_err(|()| format!("`{key}={raw}` is not a number"))
-}
-
-fn hex(line: &BTreeMap<&str, &str>, key: &str) -> Result<u32, String> {
-    let raw = line
-        .get(key)
-        .ok_or_else(|| format!("no `{key}=` in the firmware's line"))?;
-    u32::from_str_radix(raw.trim_start_matches("0x"), 16)
-        .map_err(|_| format!("`{key}={raw}` is not hex"))
-}
-
-/// The line of `lines` whose message starts with `word`.
-pub fn line_with<'a>(
-    lines: &'a [String],
-    word: &str,
-) -> Result<BTreeMap<&'a str, &'a str>, String> {
-    lines
-        .iter()
-        .find(|l| l.split_whitespace().nth(1) == Some(word))
-        .map(|l| fields(l))
-        .ok_or_else(|| format!("the firmware printed no `{word}` line"))
-}
-
-pub fn flag_names(bits: u8) -> Vec<&'static str> {
-    Flags::from_bits(bits)
-        .named()
-        .into_iter()
-        .filter_map(|(on, name)| on.then_some(name))
-        .collect()
 }
 
 /// Entry.
@@ -515,115 +470,4 @@ fn print_summary(r: &serde_json::Value) {
         "bit-exact against the host: {} (firmware {}, host {})",
         r["bit_exact"], r["firmware_digest"], r["host_digest"]
     );
-}
-
-/// Builds the firmware for `core` in release; returns the ELF path. It streams its trace from
-/// the file named by its `trace=FILE` argument.
-pub fn build(core: Core) -> Result<String, String> {
-    match core.firmware() {
-        (Firmware::Package(package), bin) => build_package_bin(package, bin, core, None, &[]),
-        (Firmware::Manifest(manifest), bin) => {
-            let dir = workspace_root().join("target");
-            let manifest = workspace_root().join(manifest);
-            shell::run(
-                cargo()
-                    .args(["build", "--release", "--bin", bin, "--manifest-path"])
-                    .arg(&manifest)
-                    .args(["--target", core.triple(), "--target-dir"])
-                    .arg(&dir),
-            )?;
-            let elf = dir.join(core.triple()).join("release").join(bin);
-            Ok(elf.to_string_lossy().into_owned())
-        }
-    }
-}
-
-/// Builds a target binary of the `noback` package in release for `core` (into `target_dir`,
-/// `target/` by default) with extra environment; returns the ELF path.
-pub fn build_bin(
-    bin: &str,
-    core: Core,
-    target_dir: Option<&std::path::Path>,
-    envs: &[(&str, &std::ffi::OsStr)],
-) -> Result<String, String> {
-    build_package_bin("noback", bin, core, target_dir, envs)
-}
-
-/// [`build_bin`] for a binary of another workspace package (the study crate's bench image).
-pub fn build_package_bin(
-    package: &str,
-    bin: &str,
-    core: Core,
-    target_dir: Option<&std::path::Path>,
-    envs: &[(&str, &std::ffi::OsStr)],
-) -> Result<String, String> {
-    let dir = target_dir.map_or_else(|| workspace_root().join("target"), std::path::PathBuf::from);
-    shell::run(
-        cargo()
-            .args(["build", "--release", "-p", package, "--bin", bin])
-            .args(["--target", core.triple(), "--target-dir"])
-            .arg(&dir)
-            .envs(envs.iter().copied()),
-    )?;
-    let elf = dir.join(core.triple()).join("release").join(bin);
-    Ok(elf.to_string_lossy().into_owned())
-}
-
-/// Mean and largest instructions per step from a bench line's `steps`, `ticks_sum` and
-/// `ticks_max` (SysTick ticks under `-icount shift=BENCH_SHIFT` on `core`).
-pub fn step_insns(line: &BTreeMap<&str, &str>, core: Core) -> Result<(f64, f64), String> {
-    insns_per_call(line, core, "ticks")
-}
-
-/// The same per `Monitor::background` call, from `bg_ticks_sum` and `bg_ticks_max`.
-pub fn background_insns(line: &BTreeMap<&str, &str>, core: Core) -> Result<(f64, f64), String> {
-    insns_per_call(line, core, "bg_ticks")
-}
-
-/// Mean and largest instructions per call from a bench line's `steps`, `{key}_sum`, `{key}_max`.
-fn insns_per_call(
-    line: &BTreeMap<&str, &str>,
-    core: Core,
-    key: &str,
-) -> Result<(f64, f64), String> {
-    let steps: f64 = field::<u32>(line, "steps")?.into();
-    let sum = field::<u64>(line, &format!("{key}_sum"))? as f64;
-    let max: f64 = field::<u32>(line, &format!("{key}_max"))?.into();
-    let per = core.ticks_per_insn(BENCH_SHIFT);
-    Ok((sum / steps.max(1.0) / per, max / per))
-}
-
-/// Boots the firmware once.
-pub fn boot(
-    core: Core,
-    elf: &str,
-    shift: u32,
-    args: Vec<String>,
-    echo: bool,
-    more: &[String],
-) -> Result<Outcome, String> {
-    let mut extra = qemu::icount(shift);
-    extra.extend_from_slice(more);
-    if echo {
-        println!(
-            "$ {}",
-            shell::describe(&qemu::command(core, elf, &extra, &args))
-        );
-    }
-    let outcome = qemu::boot(&Boot {
-        elf,
-        core,
-        timeout: BOOT_TIMEOUT,
-        extra,
-        echo,
-        args,
-    })?;
-    if outcome.code != 0 {
-        return Err(format!(
-            "the firmware exited with code {} on {}",
-            outcome.code,
-            core.name()
-        ));
-    }
-    Ok(outcome)
 }
