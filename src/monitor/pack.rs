@@ -108,21 +108,21 @@ impl PackSettings {
         };
         // A measured drag stands for the model's: at most what `sliding_mu`'s bound (μ = 2)
         // gives on the spring alone.
-        let drive_drag = match c.driving_drag_nm {
+        let (drive_drag, drag_from) = match c.driving_drag_nm {
             Some(d) => {
                 let d = finite(d, "driving_drag_nm")?;
                 let most = m.pack_torque_per_newton_m(2.0) * spring;
                 require(d > 0.0 && d <= most, "driving_drag_nm")?;
-                d
+                (d, "driving_drag_nm")
             }
-            None => a * drive_force,
+            None => (a * drive_force, "sliding_mu"),
         };
         let settings = PackSettings {
             spring_force: q16(spring, "mechanism.spring_preload_m")?,
             ramp_factor: scale(ramp, "mechanism.socket_radius_m")?,
             capacity_per_n: scale(per_n, "capacity_mu")?,
             drive_force: q16(drive_force, "sliding_mu")?,
-            drive_drag: q16(drive_drag, "sliding_mu")?,
+            drive_drag: q16(drive_drag, drag_from)?,
             overrun_gain: scale(2.0 * a_k / (a_k - 1.0), "sliding_mu")?,
             overrun_offset: q16(a * spring / (a_k - 1.0), "sliding_mu")?,
             spring_only: c.driving_pack == DrivingPack::SpringOnly,
