@@ -16,7 +16,9 @@ type SwitchOff = fn(&mut Thresholds);
 /// Each check family with its switch.
 const CHECKS: [(&str, SwitchOff); 7] = [
     ("drive step", |t| t.step_allowance_nm = 1e3),
-    ("drag", |t| t.drag_allowance_nm = 1e3),
+    ("drag (the reference or a lagging output)", |t| {
+        t.drag_allowance_nm = 1e3
+    }),
     ("braking envelope", |t| {
         t.braking_angle_factor = 16.0;
         t.undecelerated_allowance_rad = 1.0;

@@ -13,7 +13,8 @@
 //! and the gentle engagement cycle at light loads.
 
 use host_tests::accuracy::{compare, monitor_on_scene, run_monitor};
-use host_tests::mc::{draw_legacy as draw, draw_trace};
+use host_tests::family::Family;
+use host_tests::mc::{draw_in, draw_legacy as draw, draw_trace};
 use noback::monitor::Config;
 use noback_twin::fault::FaultKind;
 use noback_twin::reading::Reading;
@@ -77,4 +78,57 @@ fn a_current_reading_that_goes_dead_in_the_chatter_is_flagged_within_50_ms() {
             "run {index}: {flags:?}"
         );
     }
+}
+
+/// Tuning seed 1616's plant-family drag draws 15, 43 and 57: the paper form's continuous
+/// closing, where the drive leads the door with no torque, the drag onset while the output lags
+/// the input (in 15, as the output draws level with it). The drive checks see no torque; the
+/// stuck counter called the encoder 53–97 ms after the onset. Now `brake_drag` within 50 ms from
+/// the output's fall, and nothing without the drag.
+#[test]
+fn a_drag_while_the_paper_forms_output_lags_its_input_is_found_within_50_ms() {
+    for index in [15, 43, 57] {
+        let mut d = draw_in(Family::Plant, 1616, index, Some(FaultKind::Drag));
+        let fault = d.scene.faults[0];
+        assert_eq!(d.scene.kind, SceneKind::ContinuousClosing);
+        assert_eq!(d.scene.reading, Reading::Paper);
+        let flags = |d: &host_tests::mc::Draw| {
+            let trace = draw_trace(d).expect("twin");
+            compare(
+                &trace,
+                &run_monitor(&trace, Config::default()).expect("monitor"),
+            )
+            .flag_times()
+        };
+        let with = flags(&d);
+        println!(
+            "run {index}: drag {:.2} from {:.4} s: {with:?}",
+            fault.severity, fault.at_s
+        );
+        let window = fault.at_s..fault.at_s + 0.05;
+        assert!(
+            matches!(with.first(), Some(("brake_drag", t)) if window.contains(t)),
+            "run {index}: {with:?}"
+        );
+        d.scene.faults.clear();
+        assert_eq!(flags(&d), vec![], "run {index} without the drag");
+    }
+}
+
+/// Tuning seed 11's healthy plant-family draw 65301: the paper form's continuous closing at
+/// 29 N·m, the ramps braking the output from twice the input's speed. It falls behind its input
+/// while the observer is still tracking that braking (`J_s·ω̇` 8 N·m lower 10 ms on): a lag
+/// armed on it called `brake_drag`. Arming waits for `J_s·ω̇` to hold still.
+#[test]
+fn an_engagement_still_braking_as_the_output_falls_behind_is_no_drag() {
+    let d = draw_in(Family::Plant, 11, 65301, None);
+    assert_eq!(d.scene.kind, SceneKind::ContinuousClosing);
+    assert_eq!(d.scene.reading, Reading::Paper);
+    let trace = draw_trace(&d).expect("twin");
+    let flags = compare(
+        &trace,
+        &run_monitor(&trace, Config::default()).expect("monitor"),
+    )
+    .flag_times();
+    assert_eq!(flags, vec![], "healthy run 65301 at seed 11");
 }

@@ -11,12 +11,14 @@
 //! | dead current reading | `sensor_fault` | window lane, drive on | `dead_current.rs` |
 //! | reading against the drive's command | `sensor_fault` | every tick, drive on, command given | `current_command.rs` |
 //! | an overrunning load the pack let through | `brake_degraded` (warning) | slow lane, `Checks`, drive on, moving | `overrunning.rs` |
+//! | drag while the output lags its input | `brake_drag` | slow lane, `Checks`, drive on, moving | `lagging.rs` |
 
 mod current_command;
 mod dead_current;
 mod drive;
 mod envelope;
 mod hold;
+mod lagging;
 mod overrunning;
 mod slip;
 
@@ -43,6 +45,7 @@ use drive::{DriveChecks, DriveTick};
 use envelope::Envelope;
 pub(crate) use envelope::{BrakingTick, Decel};
 use hold::HoldChecks;
+use lagging::{LagTick, Lagging};
 use overrunning::Overrunning;
 
 /// The checks' constants.
@@ -112,6 +115,7 @@ pub(crate) struct Checks {
     dead_current: DeadCurrent,
     command: CommandCheck,
     overrunning: Overrunning,
+    lagging: Lagging,
 }
 
 impl Checks {
@@ -124,6 +128,7 @@ impl Checks {
             dead_current: DeadCurrent::default(),
             command: CommandCheck::default(),
             overrunning: Overrunning::default(),
+            lagging: Lagging::default(),
         }
     }
 
@@ -137,6 +142,7 @@ impl Checks {
         self.weak_ticks = 0;
         self.drive.reset();
         self.overrunning.disarm();
+        self.lagging.disarm();
         self.envelope = Envelope::default();
         self.hold.restart(counters.0, counters.1);
     }
@@ -231,6 +237,22 @@ impl Checks {
                         .sample(&k.overrunning, c.dir, input, c.along);
             } else {
                 self.overrunning.disarm();
+            }
+            // A pack that drags while the output falls behind its input.
+            if drive && oc.settled && oc.sensors_ok && !c.dir.is_none() && x.out_ok {
+                let t = LagTick {
+                    dir: c.dir,
+                    lagging: c.input_gaining,
+                    output_speed: oc.w,
+                    input_speed: i.input_speed,
+                    stick_speed: i.stick_speed,
+                    accel_torque: oc.net.saturating_add(oc.drive_torque),
+                    out: x.out,
+                    ticks: x.n,
+                };
+                raised.brake_drag |= self.lagging.sample(&k.drive, &t);
+            } else {
+                self.lagging.disarm();
             }
             if drive && checks_ok && c.steady_for_checks {
                 let t = DriveTick {

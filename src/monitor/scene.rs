@@ -161,6 +161,9 @@ pub(crate) struct Classified {
     /// observer's settling time.
     pub steady_for_learning: bool,
     pub steady_for_checks: bool,
+    /// Over the last synchronism window the input gained on the output beyond the band, along
+    /// the motion (the counters: the output lags).
+    pub input_gaining: bool,
 }
 
 impl Classified {
@@ -179,6 +182,7 @@ impl Classified {
         phase_settled: false,
         steady_for_learning: false,
         steady_for_checks: false,
+        input_gaining: false,
     };
 
     /// Ramps engaged: the drive off (both socket faces clamp) or overrunning.
@@ -208,6 +212,8 @@ pub(crate) struct Classify {
     ahead_out: i32,
     sync_out: u32,
     sync_motor: u32,
+    /// The last window's input gained on the output beyond the band (along the motion).
+    input_gaining: bool,
     /// Ticks since the last classification.
     since: u32,
     turn: Turn,
@@ -226,6 +232,7 @@ impl Classify {
             ahead_out: 0,
             sync_out: 0,
             sync_motor: 0,
+            input_gaining: false,
             since: 0,
             turn: Turn::None,
         }
@@ -243,7 +250,7 @@ impl Classify {
             self.steady_ticks = self.steady_ticks.saturating_add(o.head_start);
         }
         if x.drive_edge {
-            self.steady_ticks = 0;
+            (self.steady_ticks, self.input_gaining) = (0, false);
             self.phase = if x.drive {
                 (self.ahead_motor, self.ahead_out) = (0, 0);
                 Phase::Driving(Reading::none())
@@ -374,6 +381,7 @@ impl Classify {
             phase_settled: self.phase_ticks >= k.engage_settle_ticks,
             steady_for_learning,
             steady_for_checks,
+            input_gaining: self.input_gaining,
         }
     }
 
@@ -435,6 +443,7 @@ impl Classify {
         (self.sync_out, self.sync_motor) = (x.out, x.motor);
         let gain = k.motor_to_out.apply(d_m).saturating_sub(d_o);
         let synchronous = gain.saturating_abs() <= k.sync_band_counts;
+        self.input_gaining = dir.apply_count(gain) > k.sync_band_counts;
         if !dir.is_none() {
             let average = |mean: i32, d: i32| {
                 mean.saturating_add(dir.apply_count(d))

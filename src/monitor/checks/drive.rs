@@ -28,7 +28,7 @@ const FLOOR_RISE_SLOWER: u32 = 4;
 /// `state` moved towards `x` by `2^-shift` of the way (saturating difference; `shift` ≤ 31, so
 /// the shift is exact).
 #[inline]
-fn follow(state: Q16, x: Q16, shift: u32) -> Q16 {
+pub(super) fn follow(state: Q16, x: Q16, shift: u32) -> Q16 {
     state.saturating_add(Q16::from_bits(
         x.saturating_sub(state).to_bits().wrapping_shr(shift),
     ))
@@ -65,6 +65,26 @@ pub(crate) struct DriveSettings {
 }
 
 impl DriveSettings {
+    /// The flags' persistence (ticks).
+    pub fn persistence_ticks(&self) -> u32 {
+        self.persistence_ticks
+    }
+
+    /// The drag a pack may add beyond the drive drag (N·m).
+    pub fn drag_allowance(&self) -> Q16 {
+        self.drag_limit.saturating_sub(self.drive_drag)
+    }
+
+    /// How far `J_s·ω̇` may move and still count as holding still: a quarter of the allowance.
+    pub fn settle_band(&self) -> Q16 {
+        Q16::from_bits(self.drag_allowance().to_bits() >> 2)
+    }
+
+    /// The histories' shift (`follow`).
+    pub fn reference_shift(&self) -> u32 {
+        self.drive_ref_shift
+    }
+
     pub fn new(
         c: &Config,
         pack: &PackSettings,
