@@ -128,24 +128,31 @@ mod tests {
             .drive
     }
 
-    /// One call: the output lagging its input or not, `J_s·ω̇` at `accel` N·m; the output
-    /// counter advances by `step` counts a call.
-    fn call(check: &mut Lagging, p: &DriveSettings, lagging: bool, accel: f64, step: u32) -> bool {
-        let t = LagTick {
+    /// A call's reading: the input at 10 rad/s, the output at `output`, the counters reading a
+    /// lag or not, `J_s·ω̇` at `accel` N·m, the output counter at `out`.
+    fn tick(lagging: bool, output: f64, accel: f64, out: u32) -> LagTick {
+        LagTick {
             dir: Dir::of(Q16::ONE, Q16::ZERO),
             lagging,
-            output_speed: Q16::from_num(if lagging { 5.0 } else { 15.0 }),
+            output_speed: Q16::from_num(output),
             input_speed: Q16::from_num(10.0),
             stick_speed: Q16::from_num(0.3),
             accel_torque: Q16::from_num(accel),
-            out: check.out.wrapping_add(step),
+            out,
             ticks: 1,
-        };
-        check.sample(p, &t)
+        }
     }
 
-    /// One call with the output at `output` rad/s (the input at 10), counters reading a lag
-    /// or not, `J_s·ω̇` at `accel` N·m.
+    /// One call: the output lagging its input (at 5 rad/s) or ahead of it (at 15), `J_s·ω̇` at
+    /// `accel` N·m; the output counter advances by `step` counts a call.
+    fn call(check: &mut Lagging, p: &DriveSettings, lagging: bool, accel: f64, step: u32) -> bool {
+        let output = if lagging { 5.0 } else { 15.0 };
+        let out = check.out.wrapping_add(step);
+        check.sample(p, &tick(lagging, output, accel, out))
+    }
+
+    /// One call with the output at `output` rad/s, counters reading a lag or not, `J_s·ω̇` at
+    /// `accel` N·m.
     fn at_speed(
         check: &mut Lagging,
         p: &DriveSettings,
@@ -153,17 +160,8 @@ mod tests {
         output: f64,
         accel: f64,
     ) -> bool {
-        let t = LagTick {
-            dir: Dir::of(Q16::ONE, Q16::ZERO),
-            lagging,
-            output_speed: Q16::from_num(output),
-            input_speed: Q16::from_num(10.0),
-            stick_speed: Q16::from_num(0.3),
-            accel_torque: Q16::from_num(accel),
-            out: check.out.wrapping_add(5),
-            ticks: 1,
-        };
-        check.sample(p, &t)
+        let out = check.out.wrapping_add(5);
+        check.sample(p, &tick(lagging, output, accel, out))
     }
 
     /// Calls covering the persistence time, plus one.
@@ -210,21 +208,12 @@ mod tests {
         for (counters, output) in [(true, 9.8), (false, 5.0)] {
             let mut check = Lagging::default();
             let raised = (0..4 * persistence_calls(&p)).any(|k| {
-                let t = LagTick {
-                    dir: Dir::of(Q16::ONE, Q16::ZERO),
-                    lagging: counters,
-                    output_speed: Q16::from_num(output),
-                    input_speed: Q16::from_num(10.0),
-                    stick_speed: Q16::from_num(0.3),
-                    accel_torque: Q16::from_num(if k < persistence_calls(&p) {
-                        10.0
-                    } else {
-                        -30.0
-                    }),
-                    out: k * 5,
-                    ticks: 1,
+                let accel = if k < persistence_calls(&p) {
+                    10.0
+                } else {
+                    -30.0
                 };
-                check.sample(&p, &t)
+                check.sample(&p, &tick(counters, output, accel, k * 5))
             });
             assert!(!raised, "counters {counters}, output {output} rad/s");
         }

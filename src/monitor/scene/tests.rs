@@ -1,5 +1,7 @@
 //! The scene classifier's unit tests.
 
+#![cfg(test)]
+
 use super::*;
 
 /// Runs `windows` synchronism windows of a drive, the output and the input turning at

@@ -1,5 +1,7 @@
 //! The drive checks' unit tests.
 
+#![cfg(test)]
+
 use super::*;
 use crate::monitor::Config;
 
