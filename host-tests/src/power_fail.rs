@@ -147,12 +147,19 @@ pub fn run(records: &[Vec<u8>]) -> Result<Figures, String> {
         } else {
             f.in_flight_absent += 1;
         }
-        // It keeps working: the rest go in and the newest come back in order.
-        let rest_ok = records[done..].iter().all(|r| s.push(r).is_ok());
+        // It keeps working: the records after the one in flight go in (the firmware lost that
+        // one with its RAM) and the newest come back in order.
+        let rest = records.get(done + 1..).unwrap_or(&[]);
+        let rest_ok = rest.iter().all(|r| s.push(r).is_ok());
         let (after, corrupt) = read_back(&mut s, records)?;
         f.corrupt_reads += corrupt;
+        let newest = if rest.is_empty() && !found.contains(&done) {
+            done.checked_sub(1)
+        } else {
+            Some(n - 1)
+        };
         let newest_in_order =
-            after.last() == Some(&(n - 1)) && after.windows(2).all(|w| w[0] < w[1]);
+            after.last().copied() == newest && after.windows(2).all(|w| w[0] < w[1]);
         if !rest_ok || !newest_in_order {
             f.stopped_working += 1;
         }
