@@ -1,17 +1,17 @@
 //! Speed benchmark (issue 18): each paper scene of the `physical` reading against its converged
 //! reference (`tests/reference/converged.json`, tolerance 1e-10), timed (best of three) with its
 //! worst relative error, beside the independent scipy `solve_ivp(method="Radau")` solve of the
-//! same equations (`bench/radau.py`) and the compiled diffsol BDF peer (`solver::peer`, same
+//! same equations (`bench/radau.py`) and diffsol's TR-BDF2 (another method on the same
 //! `OdeSystem`, same event rule) at the same tolerance. A speed ratio is printed only where both
 //! sides hold every compared metric within 1 % of the reference (matched accuracy).
 //!
-//! `cargo run --release -p noback-twin --features peer --example bench -- [--tolerance TOL] [--no-scipy] [--json | --json-out PATH]`
+//! `cargo run --release -p noback-twin --example bench -- [--tolerance TOL] [--no-scipy] [--json | --json-out PATH]`
 use noback_twin::convergence::{self, Entry};
 use noback_twin::metrics;
 use noback_twin::reading::Reading;
 use noback_twin::scene::{Scene, SceneKind};
 use noback_twin::sim;
-use noback_twin::solver::peer::{Method, Peer};
+use noback_twin::solver::{Integrator, Method};
 use serde_json::{json, Value};
 
 /// The metrics both sides report (scipy's script reports only these).
@@ -59,7 +59,7 @@ fn main() {
     let script = format!("{root}/bench/radau.py");
     let mut rows: Vec<Value> = Vec::new();
     if !as_json {
-        println!("| scene | reference braking time / angle (1e-10) | twin wall (s) | twin RHS evals | twin worst error | diffsol BDF wall (s) | diffsol worst error | diffsol / twin wall | scipy Radau wall (s) | scipy RHS evals | scipy braking time / angle | scipy worst error | scipy / twin wall at matched accuracy |");
+        println!("| scene | reference braking time / angle (1e-10) | twin (BDF) wall (s) | twin RHS evals | twin worst error | TR-BDF2 wall (s) | TR-BDF2 worst error | TR-BDF2 / twin wall | scipy Radau wall (s) | scipy RHS evals | scipy braking time / angle | scipy worst error | scipy / twin wall at matched accuracy |");
         println!("|---|---|---|---|---|---|---|---|---|---|---|---|---|");
     }
     for kind in [
@@ -88,12 +88,15 @@ fn main() {
         let mut ds_best = f64::INFINITY;
         let mut ds_last = None;
         for _ in 0..3 {
-            match sim::run_with(&s, Peer::new(Method::Bdf, sim::solver_options(&s))) {
+            match sim::run_with(
+                &s,
+                Integrator::with_method(Method::TrBdf2, sim::solver_options(&s)),
+            ) {
                 Ok(r) => {
                     ds_best = ds_best.min(r.wall_s);
                     ds_last = Some(metrics::compute(&s, &r.samples, &r.stats, r.wall_s));
                 }
-                Err(e) => eprintln!("{} (diffsol): {e}", kind.name()),
+                Err(e) => eprintln!("{} (TR-BDF2): {e}", kind.name()),
             }
         }
         let ds_err = ds_last
@@ -140,8 +143,8 @@ fn main() {
             "tolerance": tol,
             "reference": {"tolerance": 1e-10, "braking_time_s": reference("braking_time_s"), "braking_angle_rad": reference("braking_angle_rad")},
             "twin": {"wall_s": best, "rhs_evals": m.rhs_evals, "braking_time_s": m.braking_time_s, "braking_angle_rad": m.braking_angle_rad, "worst_rel_error": twin_err},
-            "diffsol_bdf": ds_last.as_ref().map(|d| json!({"wall_s": ds_best, "rhs_evals": d.rhs_evals, "braking_time_s": d.braking_time_s, "braking_angle_rad": d.braking_angle_rad, "worst_rel_error": ds_err})),
-            "diffsol_ratio_at_matched_accuracy": (matched(twin_err) && matched(ds_err)).then(|| ds_best / best),
+            "tr_bdf2": ds_last.as_ref().map(|d| json!({"wall_s": ds_best, "rhs_evals": d.rhs_evals, "braking_time_s": d.braking_time_s, "braking_angle_rad": d.braking_angle_rad, "worst_rel_error": ds_err})),
+            "tr_bdf2_ratio_at_matched_accuracy": (matched(twin_err) && matched(ds_err)).then(|| ds_best / best),
             "scipy_radau": {"run": py, "worst_rel_error": py_err},
             "ratio_at_matched_accuracy": ratio,
         }));

@@ -1,16 +1,16 @@
 //! Work–precision (issue 18): each paper scene of the `physical` reading under the twin's
-//! Rosenbrock and the diffsol peers (BDF, TR-BDF2) at tolerances 1e-3 … 1e-7; per run the worst
+//! integrator (diffsol BDF) and diffsol's SDIRK methods (TR-BDF2, ESDIRK34) at tolerances
+//! 1e-3 … 1e-7; per run the worst
 //! relative error over every metric the converged reference has (1 % / 1e-6 absolute rule of
 //! `convergence::close`) and the wall time (best of `--repeat`, default 3). Prints JSON lines.
 //!
-//! `cargo run --release -p noback-twin --features peer --example work_precision -- [--repeat N]`
+//! `cargo run --release -p noback-twin --example work_precision -- [--repeat N]`
 use noback_twin::convergence::{self, Entry, ABS_SLACK};
 use noback_twin::metrics;
 use noback_twin::reading::Reading;
 use noback_twin::scene::{Scene, SceneKind};
 use noback_twin::sim;
-use noback_twin::solver::peer::{Method, Peer};
-use noback_twin::solver::{Integrator, SegmentSolver};
+use noback_twin::solver::{Integrator, Method};
 use serde_json::json;
 
 /// Tolerances of the sweep, loosest first.
@@ -39,7 +39,7 @@ fn worst(refs: &[Entry], scene: &str, m: &metrics::Metrics) -> Option<(f64, Stri
 /// Best wall time and the last run, or the solver's error.
 type Timed = Result<(f64, sim::Run), String>;
 
-fn time<I: SegmentSolver>(s: &Scene, make: &dyn Fn() -> I, repeat: usize) -> Timed {
+fn time(s: &Scene, make: &dyn Fn() -> Integrator, repeat: usize) -> Timed {
     let mut best = f64::INFINITY;
     let mut last = None;
     for _ in 0..repeat {
@@ -75,20 +75,12 @@ fn main() {
             let mut s = Scene::builtin(kind, Reading::Physical);
             s.tolerance = tol;
             let opts = sim::solver_options(&s);
-            let runs: [(&str, Timed); 3] = [
+            let runs = [Method::Bdf, Method::TrBdf2, Method::Esdirk34].map(|m| {
                 (
-                    "twin-rosenbrock",
-                    time(&s, &|| Integrator::new(opts), repeat),
-                ),
-                (
-                    Method::Bdf.name(),
-                    time(&s, &|| Peer::new(Method::Bdf, opts), repeat),
-                ),
-                (
-                    Method::TrBdf2.name(),
-                    time(&s, &|| Peer::new(Method::TrBdf2, opts), repeat),
-                ),
-            ];
+                    m.name(),
+                    time(&s, &|| Integrator::with_method(m, opts), repeat),
+                )
+            });
             for (solver, r) in runs {
                 let line = match r {
                     Ok((wall, run)) => {

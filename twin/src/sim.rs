@@ -7,7 +7,7 @@ use crate::model::physical::Physical;
 use crate::model::{Drive, ModelConfig, Sample, TwinModel};
 use crate::reading::Reading;
 use crate::scene::{Scene, SceneKind};
-use crate::solver::{Integrator, Sampler, SegmentSolver, SolverError, SolverOptions, SolverStats};
+use crate::solver::{Integrator, Sampler, SolverError, SolverOptions, SolverStats};
 
 /// Trace and sample rate (Hz): the monitor's 10 kHz.
 pub const SAMPLE_RATE_HZ: f64 = 10_000.0;
@@ -104,13 +104,12 @@ pub fn run(scene: &Scene) -> Result<Run, SolverError> {
 pub fn solver_options(scene: &Scene) -> SolverOptions {
     SolverOptions {
         tolerance: scene.tolerance,
-        max_step_s: 1e-3,
         ..SolverOptions::default()
     }
 }
 
-/// Run a scene under its reading with a given integrator (the twin's, or a peer).
-pub fn run_with<I: SegmentSolver>(scene: &Scene, integ: I) -> Result<Run, SolverError> {
+/// Run a scene under its reading with a given integrator (another method or settings).
+pub fn run_with(scene: &Scene, integ: Integrator) -> Result<Run, SolverError> {
     let cfg = model_config(scene);
     match scene.reading {
         Reading::Paper => run_model_with(scene, Paper::new(cfg), integ),
@@ -124,10 +123,10 @@ pub fn run_model<M: TwinModel>(scene: &Scene, model: M) -> Result<Run, SolverErr
 }
 
 /// Run a scene with a given model and integrator.
-pub fn run_model_with<M: TwinModel, I: SegmentSolver>(
+pub fn run_model_with<M: TwinModel>(
     scene: &Scene,
     mut model: M,
-    mut integ: I,
+    mut integ: Integrator,
 ) -> Result<Run, SolverError> {
     let start = std::time::Instant::now();
     let mut y = model.initial_state();
@@ -178,7 +177,7 @@ pub fn run_model_with<M: TwinModel, I: SegmentSolver>(
     }
     Ok(Run {
         samples,
-        stats: integ.stats(),
+        stats: integ.stats,
         wall_s: start.elapsed().as_secs_f64(),
     })
 }

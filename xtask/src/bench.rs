@@ -365,7 +365,7 @@ fn twin_variants(quick: bool, variants: &mut Vec<Variant>) -> Result<References,
                 variants.push(Variant {
                     family: format!("twin-{}", reading.name()),
                     format: "f64".into(),
-                    method: format!("rosenbrock tol={tol:e}"),
+                    method: format!("bdf tol={tol:e}"),
                     rate_hz: 0.0,
                     scene: name,
                     e,

@@ -1,6 +1,6 @@
 //! `cargo xtask twin-bench [--tolerance TOL] [--no-scipy] [--scipy-tolerances A,B] [--json]` — the twin's speed and
-//! worst error against its converged reference on each paper scene (release build), beside the
-//! compiled diffsol peer (same `OdeSystem`, `--features peer`) and an independent solve of the
+//! worst error against its converged reference on each paper scene (release build), beside
+//! diffsol's TR-BDF2 (same `OdeSystem`) and an independent solve of the
 //! same equations with scipy's `solve_ivp(method="Radau")` (`bench/radau.py`; installed with pip
 //! when missing); then the work–precision sweep (`examples/work_precision.rs`). Writes
 //! `docs/results/twin-speed.md` and `work-precision.svg` (benchmark pages); `--json` only prints.
@@ -34,8 +34,6 @@ pub fn main(args: &[String]) -> Result<i32, String> {
         "--release",
         "-p",
         "noback-twin",
-        "--features",
-        "peer",
         "--example",
         "bench",
         "--",
@@ -69,8 +67,6 @@ pub fn main(args: &[String]) -> Result<i32, String> {
         "--release",
         "-p",
         "noback-twin",
-        "--features",
-        "peer",
         "--example",
         "work_precision",
     ]);
@@ -117,15 +113,15 @@ pub fn main(args: &[String]) -> Result<i32, String> {
     print!("{wp_md}");
     let machine = crate::machine::this();
     let doc = format!(
-        "# Twin speed against diffsol and scipy Radau (benchmark page)\n\nWritten by `cargo xtask twin-bench{}`; do not edit. \
+        "# Twin speed against diffsol's SDIRK methods and scipy Radau (benchmark page)\n\nWritten by `cargo xtask twin-bench{}`; do not edit. \
          Release build, physical reading, same equations and tolerance on both sides. Wall times \
          from one run on {machine} (shared): a benchmark, not a test, and they change \
          from run to run. Errors are against the converged references \
          (`twin/tests/reference/converged.json`, tolerance 1e-10; braking time and angle, the \
          metrics both sides report); a speed ratio is given only where both sides hold them within 1 % (continuous closing has \
-         neither, so no ratio). diffsol BDF runs the twin's own `OdeSystem` (`twin/src/solver/peer.rs`) \
-         and its error is over the same two metrics here; the work–precision section below \
-         takes every metric.\n\n{table}\n## Work–precision\n\n\
+         neither, so no ratio). The twin integrates with diffsol's BDF (`twin/src/solver/integrator.rs`); \
+         TR-BDF2 is another of diffsol's methods on the same `OdeSystem`, its error over the same \
+         two metrics here; the work–precision section below takes every metric.\n\n{table}\n## Work–precision\n\n\
          `examples/work_precision.rs`: tolerances 1e-3 … 1e-7, best of three runs each; error = \
          worst relative error over every metric of the scene that has a converged reference \
          (scipy Radau: braking time and angle only, at 1e-3, 1e-4 and the bench's tolerance). A solver meets an accuracy level at \

@@ -1,4 +1,5 @@
-//! Work–precision of the twin's Rosenbrock against the diffsol peers and scipy Radau (issue 18):
+//! Work–precision of the twin's integrator (diffsol BDF) against diffsol's SDIRK methods and scipy
+//! Radau (issue 18):
 //! the table (per scene, solver and tolerance: wall time, worst relative error against the
 //! converged reference), the speed ratio at matched accuracy, and the chart (one panel per
 //! scene, error against wall time, log–log, engineering notation).
@@ -12,54 +13,7 @@ pub const LEVELS: [f64; 2] = [1e-2, 1e-3];
 /// Errors below this are drawn at it (log axes).
 const FLOOR: f64 = 1e-9;
 
-/// `v` in engineering notation with an SI prefix (`2.5 m`, `100 k`, `1 M`).
-pub fn eng(v: f64) -> String {
-    if v == 0.0 || !v.is_finite() {
-        return format!("{v}");
-    }
-    const P: [(f64, &str); 9] = [
-        (1e12, "T"),
-        (1e9, "G"),
-        (1e6, "M"),
-        (1e3, "k"),
-        (1.0, ""),
-        (1e-3, "m"),
-        (1e-6, "µ"),
-        (1e-9, "n"),
-        (1e-12, "p"),
-    ];
-    let a = v.abs() * (1.0 + 1e-9);
-    let (scale, prefix) = P
-        .iter()
-        .copied()
-        .find(|(s, _)| a >= *s)
-        .unwrap_or((1e-12, "p"));
-    let m = v / scale;
-    let digits = if m.abs() >= 100.0 {
-        0
-    } else if m.abs() >= 10.0 {
-        1
-    } else {
-        2
-    };
-    let s = format!("{m:.digits$}");
-    let s = if s.contains('.') {
-        s.trim_end_matches('0').trim_end_matches('.').to_string()
-    } else {
-        s
-    };
-    format!("{s}{}{prefix}", if prefix.is_empty() { "" } else { " " })
-}
-
-/// `v` with a unit in engineering notation (`715 mN·m`, `2.57 N·m`).
-pub fn eng_unit(v: f64, unit: &str) -> String {
-    let e = eng(v);
-    if e.contains(' ') {
-        format!("{e}{unit}")
-    } else {
-        format!("{e} {unit}")
-    }
-}
+pub use noback_twin::svg::{eng, eng_unit};
 
 /// The log-axis range spanning whole decades around `[lo, hi]`, at least one decade wide.
 pub fn decades(lo: f64, hi: f64) -> (f64, f64) {
@@ -151,7 +105,7 @@ fn solvers(pts: &[Point]) -> Vec<String> {
 /// The markdown: the matched-accuracy summary, then every point.
 pub fn markdown(pts: &[Point]) -> String {
     let mut md = String::from(
-        "| scene | accuracy level | twin Rosenbrock: tol, wall | diffsol BDF: tol, wall | diffsol TR-BDF2: tol, wall | twin wall / best peer wall |\n|---|---|---|---|---|---|\n",
+        "| scene | accuracy level | twin (diffsol BDF): tol, wall | diffsol TR-BDF2: tol, wall | diffsol ESDIRK34: tol, wall | twin wall / best peer wall |\n|---|---|---|---|---|---|\n",
     );
     for scene in scenes(pts) {
         for level in LEVELS {
@@ -160,8 +114,8 @@ pub fn markdown(pts: &[Point]) -> String {
                     format!("{:e}, {}s", p.tolerance, eng(p.wall_s))
                 })
             };
-            let twin = cheapest(pts, &scene, "twin-rosenbrock", level);
-            let peer = ["diffsol-bdf", "diffsol-trbdf2"]
+            let twin = cheapest(pts, &scene, "diffsol-bdf", level);
+            let peer = ["diffsol-trbdf2", "diffsol-esdirk34", "scipy-radau"]
                 .iter()
                 .filter_map(|s| cheapest(pts, &scene, s, level))
                 .min_by(|a, b| a.wall_s.total_cmp(&b.wall_s));
@@ -173,9 +127,9 @@ pub fn markdown(pts: &[Point]) -> String {
                 md,
                 "| {scene} | ≤ {} % | {} | {} | {} | {ratio} |",
                 level * 100.0,
-                cell("twin-rosenbrock"),
                 cell("diffsol-bdf"),
                 cell("diffsol-trbdf2"),
+                cell("diffsol-esdirk34"),
             );
         }
     }
@@ -287,14 +241,6 @@ mod tests {
 
     #[test]
     fn engineering_notation() {
-        assert_eq!(eng(1_000_000.0), "1 M");
-        assert_eq!(eng(2.5e-3), "2.5 m");
-        assert_eq!(eng(8.524e6), "8.52 M");
-        assert_eq!(eng(150_000.0), "150 k");
-        assert_eq!(eng(0.5), "500 m");
-        assert_eq!(eng(3.0), "3");
-        assert_eq!(eng_unit(0.715, "N·m"), "715 mN·m");
-        assert_eq!(eng_unit(2.57, "N·m"), "2.57 N·m");
         assert_eq!(decades(16.9, 91.0), (10.0, 100.0));
         assert_eq!(decades(20.0, 30.0), (10.0, 100.0));
     }

@@ -1,10 +1,9 @@
-//! The compiled peer (issue 18): the same [`OdeSystem`] integrated by diffsol (BDF, or the
-//! TR-BDF2 / ESDIRK34 SDIRK methods) with diffsol's root finding; at a root the twin's own event
-//! rule (the functions that changed sign) and `on_event` apply, then diffsol re-initialises.
-//! Built only with the `peer` feature (`cargo xtask twin-bench` turns it on).
+//! The twin's integrator: an [`OdeSystem`] integrated by diffsol (variable-order BDF by default,
+//! or the TR-BDF2 / ESDIRK34 SDIRK methods) with diffsol's root finding; at a root the twin's
+//! event rule (the functions that changed sign) and `on_event` apply, then diffsol restarts.
 
-use super::{
-    EventLoopGuard, OdeSystem, Sampler, SegmentSolver, SolverError, SolverOptions, SolverStats,
+use super::system::{
+    changed, EventLoopGuard, OdeSystem, Sampler, SolverError, SolverOptions, SolverStats,
 };
 use diffsol::{
     NalgebraLU, NalgebraMat, NalgebraVec, OdeBuilder, OdeEquationsImplicit, OdeSolverMethod,
@@ -37,20 +36,26 @@ impl Method {
     }
 }
 
-/// A diffsol integrator behind the twin's segment interface.
-pub struct Peer {
+/// The integrator; keeps its counters between segments.
+#[derive(Clone, Debug)]
+pub struct Integrator {
     /// Method.
     pub method: Method,
-    /// Tolerance and step limits (max step is applied as a stop time; min step as an error).
+    /// Tolerance and step limits (a step below the minimum is an error).
     pub options: SolverOptions,
     /// Work counters (steps, rejected = error-test failures, RHS evaluations, events).
     pub stats: SolverStats,
 }
 
-impl Peer {
-    /// A peer with the twin's options.
-    pub fn new(method: Method, options: SolverOptions) -> Self {
-        Peer {
+impl Integrator {
+    /// The twin's integrator: BDF.
+    pub fn new(options: SolverOptions) -> Self {
+        Self::with_method(Method::Bdf, options)
+    }
+
+    /// An integrator with another of diffsol's methods.
+    pub fn with_method(method: Method, options: SolverOptions) -> Self {
+        Integrator {
             method,
             options,
             stats: SolverStats::default(),
@@ -58,23 +63,17 @@ impl Peer {
     }
 }
 
-fn changed(g0: f64, g1: f64) -> bool {
-    (g0 > 0.0 && g1 <= 0.0) || (g0 < 0.0 && g1 >= 0.0)
-}
-
 fn err(t: f64) -> impl Fn(diffsol::DiffsolError) -> SolverError {
-    move |e| SolverError::Peer {
+    move |e| SolverError::Diffsol {
         t_s: t,
         message: e.to_string(),
     }
 }
 
-impl SegmentSolver for Peer {
-    fn stats(&self) -> SolverStats {
-        self.stats
-    }
-
-    fn integrate<S: OdeSystem>(
+impl Integrator {
+    /// Integrate `y` from `t0` to `t1`, calling `observe(system, t, y)` at the sample times of
+    /// `sampler` that fall in `(t0, t1]` (the sampler is advanced).
+    pub fn integrate<S: OdeSystem>(
         &mut self,
         sys: &mut S,
         (t0, t1): (f64, f64),
@@ -126,7 +125,7 @@ impl SegmentSolver for Peer {
         };
         let mut problem = OdeBuilder::<M>::new()
             .t0(t0)
-            .h0((self.options.max_step_s * 1e-3).max(1e-9))
+            .h0(self.options.first_step_s)
             .rtol(tol)
             .atol(atol)
             .rhs_implicit(f, jv)
@@ -208,7 +207,12 @@ where
     let mut guard = EventLoopGuard::default();
     let mut steps = 0u64;
     solver.set_stop_time(t1).map_err(err(t0))?;
+    // At the step's own end (within rounding) the state itself: a step that lands a hair past the
+    // stop time leaves diffsol a negative step size, under which it refuses to interpolate.
     let interp = |s: &Sol, tm: f64| -> Result<Vec<f64>, SolverError> {
+        if (s.state().t - tm).abs() <= 1e-12 * tm.abs().max(1.0) {
+            return Ok(s.state().y.clone_as_vec());
+        }
         s.interpolate(tm).map(|v| v.clone_as_vec()).map_err(err(tm))
     };
     loop {
@@ -216,16 +220,19 @@ where
         if steps > options.max_steps {
             return Err(SolverError::TooManySteps { t_s: t });
         }
-        let reason = solver.step().map_err(|e| SolverError::Peer {
+        let reason = solver.step().map_err(|e| SolverError::Diffsol {
             t_s: solver.state().t,
             message: e.to_string(),
         })?;
         let t_step = solver.state().t;
+        // A step after a root return is not shortened to the stop time: past it, only the part
+        // up to the segment's end counts (the next segment restarts from there).
+        let t_hi = t_step.min(t1);
         let (t_end, fired) = match reason {
-            OdeSolverStopReason::RootFound(tr, _) => {
+            OdeSolverStopReason::RootFound(tr, _) if tr <= t1 => {
                 // The twin's rule: the functions changed between the last restart and just
                 // past the root (bisection on diffsol's interpolant up to the step end).
-                let (mut lo, mut hi) = (tr.min(t_step), t_step);
+                let (mut lo, mut hi) = (tr.min(t_hi), t_hi);
                 let first = |tm: f64, gm: &mut [f64]| -> Result<bool, SolverError> {
                     let ym = interp(&solver, tm)?;
                     cell.borrow().events(tm, &ym, gm);
@@ -248,7 +255,7 @@ where
                 let fired: Vec<usize> = (0..ne).filter(|&i| changed(g0[i], gm[i])).collect();
                 (hi, fired)
             }
-            _ => (t_step, Vec::new()),
+            _ => (t_hi, Vec::new()),
         };
         while sampler.next_s <= t_end + 1e-12 * t_end.abs().max(1.0) && sampler.next_s <= t1 + 1e-12
         {
@@ -282,15 +289,144 @@ where
             solver.set_stop_time(t1).map_err(err(t))?;
             continue;
         }
-        t = t_step;
+        t = t_hi;
         if matches!(reason, OdeSolverStopReason::TstopReached) || t >= t1 {
             let yl = interp(&solver, t)?;
             y.copy_from_slice(&yl);
             break;
         }
-        // A plain step, or a root with no sign change under the twin's rule (grazing): carry on.
+        // A plain step, or a root with no sign change under the twin's rule (grazing): carry on,
+        // with the next step shortened to the stop time again.
+        guard.step();
         let yl = interp(&solver, t)?;
         cell.borrow().events(t, &yl, &mut g0);
+        if matches!(reason, OdeSolverStopReason::RootFound(..)) {
+            solver.set_stop_time(t1).map_err(err(t))?;
+        }
     }
     Ok((solver.get_statistics().clone(), events))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// y' = −1000 (y − cos t): stiff, smooth solution ≈ cos t.
+    struct Stiff;
+    impl OdeSystem for Stiff {
+        fn dim(&self) -> usize {
+            1
+        }
+        fn scales(&self) -> Vec<f64> {
+            vec![1.0]
+        }
+        fn rhs(&self, t: f64, y: &[f64], dy: &mut [f64]) {
+            dy[0] = -1000.0 * (y[0] - t.cos());
+        }
+        fn event_count(&self) -> usize {
+            0
+        }
+        fn events(&self, _: f64, _: &[f64], _: &mut [f64]) {}
+        fn on_event(&mut self, _: f64, _: &mut [f64], _: &[usize]) {}
+    }
+
+    /// A ball falling onto the floor: an event at y = 0 reverses the speed.
+    struct Bounce {
+        bounces: u32,
+    }
+    impl OdeSystem for Bounce {
+        fn dim(&self) -> usize {
+            2
+        }
+        fn scales(&self) -> Vec<f64> {
+            vec![1.0, 1.0]
+        }
+        fn rhs(&self, _: f64, y: &[f64], dy: &mut [f64]) {
+            dy[0] = y[1];
+            dy[1] = -9.81;
+        }
+        fn event_count(&self) -> usize {
+            1
+        }
+        fn events(&self, _: f64, y: &[f64], g: &mut [f64]) {
+            g[0] = y[0];
+        }
+        fn on_event(&mut self, _: f64, y: &mut [f64], _: &[usize]) {
+            self.bounces += 1;
+            y[0] = 0.0;
+            y[1] = y[1].abs();
+        }
+    }
+
+    #[test]
+    fn stiff_problem_in_few_steps() {
+        let mut integ = Integrator::new(SolverOptions {
+            tolerance: 1e-4,
+            ..SolverOptions::default()
+        });
+        let mut y = [0.0];
+        let mut smp = Sampler::none();
+        integ
+            .integrate(&mut Stiff, (0.0, 2.0), &mut y, &mut smp, &mut |_, _, _| {})
+            .unwrap();
+        // Particular solution (the transient e^{−1000t} has died out):
+        // y = (λ² cos t + λ sin t)/(λ² + 1), λ = 1000.
+        let l = 1000.0_f64;
+        let exact = (l * l * 2.0_f64.cos() + l * 2.0_f64.sin()) / (l * l + 1.0);
+        assert!((y[0] - exact).abs() < 1e-4, "{} vs {exact}", y[0]);
+        // An explicit method would need ≥ 1000 steps (|λ|·h < 2).
+        assert!(integ.stats.steps < 300, "{:?}", integ.stats);
+    }
+
+    #[test]
+    fn locates_an_event_precisely() {
+        let mut integ = Integrator::new(SolverOptions {
+            tolerance: 1e-8,
+            ..SolverOptions::default()
+        });
+        let mut sys = Bounce { bounces: 0 };
+        let mut y = [1.0, 0.0];
+        let mut smp = Sampler::none();
+        let t_hit = (2.0 / 9.81_f64).sqrt();
+        integ
+            .integrate(
+                &mut sys,
+                (0.0, t_hit * 1.5),
+                &mut y,
+                &mut smp,
+                &mut |_, _, _| {},
+            )
+            .unwrap();
+        assert_eq!(sys.bounces, 1);
+        // After the bounce the ball rises with the impact speed: check energy is kept.
+        let energy = 0.5 * y[1] * y[1] + 9.81 * y[0];
+        assert!((energy - 9.81).abs() < 1e-5, "{energy}");
+    }
+
+    struct Blow;
+    impl OdeSystem for Blow {
+        fn dim(&self) -> usize {
+            1
+        }
+        fn scales(&self) -> Vec<f64> {
+            vec![1.0]
+        }
+        fn rhs(&self, _: f64, y: &[f64], dy: &mut [f64]) {
+            dy[0] = y[0] * y[0];
+        }
+        fn event_count(&self) -> usize {
+            0
+        }
+        fn events(&self, _: f64, _: &[f64], _: &mut [f64]) {}
+        fn on_event(&mut self, _: f64, _: &mut [f64], _: &[usize]) {}
+    }
+
+    #[test]
+    fn blow_up_is_an_error_not_nan() {
+        let mut integ = Integrator::new(SolverOptions::default());
+        let mut y = [1.0];
+        let mut smp = Sampler::none();
+        let r = integ.integrate(&mut Blow, (0.0, 2.0), &mut y, &mut smp, &mut |_, _, _| {});
+        assert!(r.is_err(), "{y:?}");
+    }
 }
