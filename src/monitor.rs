@@ -78,7 +78,7 @@ mod stop;
 
 pub use crate::fx::mul_q16;
 pub use config::{
-    AidingBraking, Config, ConfigError, DrivingPack, ObserverGains, Thresholds,
+    AidingBraking, Config, ConfigError, DrivingPack, ObserverGains, OverrunLine, Thresholds,
     DEFAULT_BRAKING_MODEL_HZ, DEFAULT_OBSERVER_BANDWIDTH_HZ, DEFAULT_TICK_HZ, POWER_ON_SEED_TICKS,
 };
 pub use io::{BrakeState, Estimate, Flags, Inputs, Scene, SceneModel, ESTIMATE_WORDS};

@@ -55,7 +55,7 @@ fn main() -> Result<(), String> {
             Ok(c) => c,
             Err(e) => {
                 t.refused += 1;
-                eprintln!("draw {i}: refused: {e}");
+                eprintln!("draw {i} ({}): refused: {e}", form(&d.scene));
                 continue;
             }
         };

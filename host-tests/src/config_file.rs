@@ -22,10 +22,13 @@
 //! inertia_kg_m2 = 0.15
 //! drag_nm = 8.4
 //! load_gain = 1.5
+//! [monitor.overrun_line]         # a relieved pack's overrunning equilibrium (OverrunLine), both
+//! gain = 6.9
+//! offset_nm = 11.6
 //! ```
 
 use noback::monitor::functional_test::TestConfig;
-use noback::monitor::{AidingBraking, Config, DrivingPack, Monitor, Thresholds};
+use noback::monitor::{AidingBraking, Config, DrivingPack, Monitor, OverrunLine, Thresholds};
 use toml::{Table, Value};
 
 fn number(v: &Value, key: &str) -> Result<f64, String> {
@@ -109,20 +112,19 @@ fn functional_test(mut given: Table) -> Result<TestConfig, String> {
     Ok(t)
 }
 
-/// `[monitor.aiding_braking]`: every field given.
-fn aiding_braking(mut given: Table) -> Result<AidingBraking, String> {
-    let mut get = |key: &str| {
-        let path = format!("monitor.aiding_braking.{key}");
-        let v = given.remove(key).ok_or(format!("{path}: missing"))?;
-        number(&v, &path)
-    };
-    let a = AidingBraking {
-        inertia_kg_m2: get("inertia_kg_m2")?,
-        drag_nm: get("drag_nm")?,
-        load_gain: get("load_gain")?,
-    };
-    no_more(&given, "monitor.aiding_braking.")?;
-    Ok(a)
+/// A table whose every one of `keys` is given (and nothing else), in `keys`' order.
+fn all_of<const N: usize>(
+    mut given: Table,
+    path: &str,
+    keys: [&str; N],
+) -> Result<[f64; N], String> {
+    let mut out = [0.0; N];
+    for (v, key) in out.iter_mut().zip(keys) {
+        let at = format!("{path}.{key}");
+        *v = number(&given.remove(key).ok_or(format!("{at}: missing"))?, &at)?;
+    }
+    no_more(&given, &format!("{path}."))?;
+    Ok(out)
 }
 
 /// Parses a configuration file's text; the result is validated by `Monitor::new`.
@@ -150,7 +152,22 @@ pub fn parse(text: &str) -> Result<Config, String> {
         c.functional_test = functional_test(table(t, "monitor.functional_test")?)?;
     }
     if let Some(t) = m.remove("aiding_braking") {
-        c.aiding_braking = Some(aiding_braking(table(t, "monitor.aiding_braking")?)?);
+        let path = "monitor.aiding_braking";
+        let [inertia_kg_m2, drag_nm, load_gain] = all_of(
+            table(t, path)?,
+            path,
+            ["inertia_kg_m2", "drag_nm", "load_gain"],
+        )?;
+        c.aiding_braking = Some(AidingBraking {
+            inertia_kg_m2,
+            drag_nm,
+            load_gain,
+        });
+    }
+    if let Some(t) = m.remove("overrun_line") {
+        let path = "monitor.overrun_line";
+        let [gain, offset_nm] = all_of(table(t, path)?, path, ["gain", "offset_nm"])?;
+        c.overrun_line = Some(OverrunLine { gain, offset_nm });
     }
     for (key, field) in [
         ("capacity_mu", &mut c.capacity_mu),
@@ -255,6 +272,12 @@ pub fn write(c: &Config, comment: &str) -> Result<String, String> {
             a.inertia_kg_m2, a.drag_nm, a.load_gain
         ));
     }
+    if let Some(l) = c.overrun_line {
+        out.push_str(&format!(
+            "[monitor.overrun_line]\ngain = {:?}\noffset_nm = {:?}\n",
+            l.gain, l.offset_nm
+        ));
+    }
     match parse(&out) {
         Ok(back) if back == *c => Ok(out),
         Ok(_) => Err("the configuration sets a field the file does not carry".into()),
@@ -295,6 +318,10 @@ mod tests {
             inertia_kg_m2: 0.1512345,
             drag_nm: 8.25,
             load_gain: 1.625,
+        });
+        c.overrun_line = Some(OverrunLine {
+            gain: 6.125,
+            offset_nm: 11.375,
         });
         let text = write(&c, "test").unwrap();
         assert_eq!(parse(&text), Ok(c), "{text}");

@@ -275,6 +275,17 @@ pub struct AidingBraking {
     pub load_gain: f64,
 }
 
+/// A relieved pack's overrunning equilibrium `y = g₁·v − g₀` measured at commissioning from
+/// closings at two loads (docs/commissioning.md); it stands for the one `sliding_mu` gives.
+#[cfg_attr(feature = "config-block", derive(serde::Serialize, serde::Deserialize))]
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct OverrunLine {
+    /// `g₁`: pack torque per N·m of drive torque along the motion (> 2: the pack self-locks).
+    pub gain: f64,
+    /// `g₀` (N·m, > 0).
+    pub offset_nm: f64,
+}
+
 /// Everything the monitor is configured with; separate from its state. With `config-block`,
 /// serde writes it as the firmware's configuration block (`config_block`).
 #[cfg_attr(feature = "config-block", derive(serde::Serialize, serde::Deserialize))]
@@ -307,6 +318,8 @@ pub struct Config {
     pub driving_drag_nm: Option<f64>,
     /// A spring-only pack's braking of an aiding load, once identified (else `None`).
     pub aiding_braking: Option<AidingBraking>,
+    /// The overrunning equilibrium, once measured (else `None`: `sliding_mu`'s).
+    pub overrun_line: Option<OverrunLine>,
     /// The phase-current reading at zero current (A), measured at commissioning with the drive
     /// off; subtracted in whole ADC counts (at most an eighth of full scale).
     pub current_offset_a: f64,
@@ -349,6 +362,7 @@ impl Config {
             driving_pack: DrivingPack::Relieved,
             driving_drag_nm: None,
             aiding_braking: None,
+            overrun_line: None,
             current_offset_a: 0.0,
             max_catchup_ticks: 8,
             braking_model_hz: DEFAULT_BRAKING_MODEL_HZ,

@@ -7,7 +7,7 @@
 //! | `ramp_factor` | `k = tanθ/r`: N of pressing force per N·m through the ramps | 50 /m |
 //! | `capacity_per_n` | `μ_s·c`: capacity per N of pressing force (m) | 0.0498 m |
 //! | `drive_force`, `drive_drag` | `F_s/(1 + a·k)` (`F_s` with `DrivingPack::SpringOnly`) and `a·F` (or the commissioned `driving_drag_nm`) while the drive carries the load | 70 N, 1.98 N·m |
-//! | `overrun_gain`, `overrun_offset` | `y = g₁·v − g₀`, the pack torque while overrunning | 6.86, 11.6 N·m |
+//! | `overrun_gain`, `overrun_offset` | `y = g₁·v − g₀`, the pack torque while overrunning (or the commissioned `overrun_line`) | 6.86, 11.6 N·m |
 
 use super::config::{Config, ConfigError, DrivingPack};
 use super::convert::{finite, positive, q16, require, scale, Q16_ENVELOPE};
@@ -117,14 +117,31 @@ impl PackSettings {
             }
             None => (a * drive_force, "sliding_mu"),
         };
+        // A measured line stands for the model's; `a·k` follows its gain, `g₁ = 2a·k/(a·k − 1)`.
+        let (gain, offset, a_k) = match c.overrun_line {
+            Some(l) => {
+                let gain = finite(l.gain, "overrun_line.gain")?;
+                require(gain > 2.0, "overrun_line.gain")?;
+                (
+                    gain,
+                    positive(l.offset_nm, "overrun_line.offset_nm")?,
+                    gain / (gain - 2.0),
+                )
+            }
+            None => (2.0 * a_k / (a_k - 1.0), a * spring / (a_k - 1.0), a_k),
+        };
+        let gain_from = c.overrun_line.map_or("sliding_mu", |_| "overrun_line.gain");
+        let offset_from = c
+            .overrun_line
+            .map_or("sliding_mu", |_| "overrun_line.offset_nm");
         let settings = PackSettings {
             spring_force: q16(spring, "mechanism.spring_preload_m")?,
             ramp_factor: scale(ramp, "mechanism.socket_radius_m")?,
             capacity_per_n: scale(per_n, "capacity_mu")?,
             drive_force: q16(drive_force, "sliding_mu")?,
             drive_drag: q16(drive_drag, drag_from)?,
-            overrun_gain: scale(2.0 * a_k / (a_k - 1.0), "sliding_mu")?,
-            overrun_offset: q16(a * spring / (a_k - 1.0), "sliding_mu")?,
+            overrun_gain: scale(gain, gain_from)?,
+            overrun_offset: q16(offset, offset_from)?,
             spring_only: c.driving_pack == DrivingPack::SpringOnly,
         };
         let ratios = PackRatios {

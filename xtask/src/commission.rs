@@ -14,8 +14,9 @@ use std::path::PathBuf;
 #[derive(clap::Args, Debug)]
 pub struct CommissionArgs {
     /// The acceptance runs, each a built-in scene, a TOML scene file or a recorded trace
-    /// (`.csv`): the drive opens against a known load, is cut, and the brake holds; two at loads
-    /// 5 N·m or more apart also give the current's gain (docs/monitor-design.md). A
+    /// (`.csv`): the drive opens against (or closes with) a known load, is cut, and the brake
+    /// holds; two openings at loads 5 N·m or more apart also give the current's gain, two
+    /// closings so the overrunning line (docs/commissioning.md). A
     /// `functional_test` scene among them sets the functional test's expected breakaway.
     #[arg(value_name = "SCENE|FILE|TRACE.csv", required = true)]
     pub targets: Vec<String>,
@@ -112,10 +113,9 @@ pub fn main(a: &CommissionArgs) -> Result<i32, String> {
         let runs: Vec<_> = c
             .runs
             .iter()
-            .zip(&a.targets)
-            .map(|(f, t)| {
+            .map(|f| {
                 json!({
-                    "run": t,
+                    "run": a.targets.get(f.run),
                     "load_nm": f.load_nm,
                     "cut_s": f.cut_s,
                     "drive_speed_rad_s": f.drive_speed_rad_s,
@@ -143,6 +143,10 @@ pub fn main(a: &CommissionArgs) -> Result<i32, String> {
                     "inertia_kg_m2": b.inertia_kg_m2,
                     "drag_nm": b.drag_nm,
                     "load_gain": b.load_gain,
+                })),
+                "overrun_line": c.config.overrun_line.map(|l| json!({
+                    "gain": l.gain,
+                    "offset_nm": l.offset_nm,
                 })),
                 "config_file": text,
             })

@@ -198,8 +198,8 @@ pub fn main(a: &FamilyArgs) -> Result<(), String> {
          draw's form is the twin's reading (`paper`, `physical`).\n\
          - *Uncommissioned*: the shipped `Config::default()`. *Commissioned*: each drawn unit \
          is first taken, healthy, through the acceptance procedure on the twin \
-         (`host_tests::commission::ACCEPTANCE`: openings against 20.3 and 8 N·m, a closing \
-         with 20.3 N·m; commissioning.md) and runs on what commissioning identified; a unit \
+         (`host_tests::commission::ACCEPTANCE`: openings against 20.3 and 8 N·m, closings \
+         with 20.3 and 5 N·m; commissioning.md) and runs on what commissioning identified; a unit \
          acceptance refuses runs uncommissioned, counted in the row so named.\n\
          - Cells: detected within 50 ms / manifested, or false alarms / nominal runs, with the \
          two-sided 95 % Clopper–Pearson interval (false alarms: its upper bound per run); after \
