@@ -22,6 +22,9 @@ use crate::fx::{lowpass, Gain, Q16};
 
 /// Ticks of output-position history: a power of two above twice the longest impact window.
 const POSITION_HISTORY: usize = 64;
+/// A second difference this small (counts) is a held output's one-count dither (`0 1 0` gives
+/// 2), not an impact: read as none.
+const DITHER_COUNTS: u16 = 2;
 
 /// The sensors' constants.
 #[cfg_attr(
@@ -404,7 +407,8 @@ impl Sense {
     }
 
     /// `J_s·α` from the second difference of the position over two windows of `m` ticks
-    /// (`θ(t) − 2θ(t−m) + θ(t−2m)`); zero until the history holds `2m` on-time ticks.
+    /// (`θ(t) − 2θ(t−m) + θ(t−2m)`); zero until the history holds `2m` on-time ticks, and
+    /// within [`DITHER_COUNTS`].
     pub fn impact_torque(&self, k: &SenseSettings) -> Q16 {
         let m = usize::from(k.impact_window);
         if self.position_ticks < 2 * u32::from(k.impact_window) {
@@ -420,6 +424,11 @@ impl Sense {
         let second = at(0)
             .wrapping_sub(at(m).wrapping_mul(2))
             .wrapping_add(at(2 * m));
+        let second = if second.unsigned_abs() <= DITHER_COUNTS {
+            0
+        } else {
+            second
+        };
         Q16::from_bits(k.impact_torque.apply(i32::from(second)))
     }
 }
@@ -486,6 +495,25 @@ mod tests {
         assert!(stuck_after(code, (0..limit / 3 + 2).map(|_| 3)));
         // Up to the limit: not yet.
         assert!(!stuck_after(code, (0..limit / 3 - 1).map(|_| 3)));
+    }
+
+    #[test]
+    fn a_held_outputs_one_count_dither_is_no_impact() {
+        let k = SenseSettings::new(&Config::default()).expect("default configuration");
+        let mut sense = Sense::new();
+        let mut largest = Q16::ZERO;
+        let mut read = |out: u32| {
+            sense.read(&k, &Inputs::new(k.adc_mid as u16, 0, out, false), 1, false);
+            sense.impact_torque(&k).saturating_abs()
+        };
+        // A count's flicker now and then, and a count's step: no impact.
+        for i in 0..200_u32 {
+            largest = largest.max(read(100 + u32::from(i % 7 == 3 && i < 120 || i > 150)));
+        }
+        assert_eq!(largest, Q16::ZERO);
+        // A knock of 4 counts is one.
+        let knock = (0..40).map(|_| read(105)).fold(Q16::ZERO, Q16::max);
+        assert!(knock > Q16::from_num(40), "{knock}");
     }
 
     #[test]
