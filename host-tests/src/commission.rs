@@ -280,13 +280,11 @@ pub fn commission(runs: &[(&Trace, f64)]) -> Result<Commissioning, String> {
     let dir = Some(first.drive_speed_rad_s.signum());
     // A closing after the first serves a relieved pack's overrunning line alone: a refusal of
     // it waits until the openings show the pack's form.
-    let (mut figures, mut later_closing_refused, mut closings) = (Vec::new(), None, 0);
+    let (mut figures, mut later_closing_refused) = (Vec::<RunFigures>::new(), None);
     for (i, (t, load)) in runs.iter().enumerate() {
-        let closing = i > 0 && Some(driven_sign(t, &base)) != dir;
-        closings += usize::from(closing);
         match measure(t, *load, base, dir.filter(|_| i > 0)) {
             Ok(f) => figures.push(RunFigures { run: i, ..f }),
-            Err(e) if closing && closings > 1 => {
+            Err(e) if figures.iter().any(|f| f.closing) && Some(driven_sign(t, &base)) != dir => {
                 later_closing_refused.get_or_insert(name(i) + &e);
             }
             Err(e) => return Err(name(i) + &e),
@@ -295,12 +293,7 @@ pub fn commission(runs: &[(&Trace, f64)]) -> Result<Commissioning, String> {
     // The first run opens: never empty.
     let opening: Vec<&RunFigures> = figures.iter().filter(|f| !f.closing).collect();
     // Drive torque against the load: −D̂ = g·(M + drag), one line through the opening runs.
-    let (lo, hi) = opening
-        .iter()
-        .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), f| {
-            (lo.min(f.load_nm), hi.max(f.load_nm))
-        });
-    let gain = if hi - lo >= MIN_LOAD_SPAN_NM {
+    let gain = if load_span(&opening) >= MIN_LOAD_SPAN_NM {
         line(opening.iter().map(|f| (f.load_nm, f.along_nm()))).0
     } else if opening.len() > 1 {
         return Err(format!(
@@ -384,6 +377,12 @@ pub fn commission(runs: &[(&Trace, f64)]) -> Result<Commissioning, String> {
     })
 }
 
+/// How far apart the runs' loads lie (N·m; −∞ for none).
+fn load_span(runs: &[&RunFigures]) -> f64 {
+    let loads = runs.iter().map(|f| f.load_nm);
+    loads.clone().fold(f64::NEG_INFINITY, f64::max) - loads.fold(f64::INFINITY, f64::min)
+}
+
 /// The least-squares line `y = slope·x + intercept` through `points` (two or more, not all at
 /// one `x`): (slope, intercept).
 fn line(points: impl Iterator<Item = (f64, f64)> + Clone) -> (f64, f64) {
@@ -403,10 +402,7 @@ fn overrun_line(closings: &[&RunFigures], gain: f64) -> Result<Option<OverrunLin
     if closings.len() < 2 {
         return Ok(None);
     }
-    let loads = closings.iter().map(|f| f.load_nm);
-    let span =
-        loads.clone().fold(f64::NEG_INFINITY, f64::max) - loads.fold(f64::INFINITY, f64::min);
-    if span < MIN_LOAD_SPAN_NM {
+    if load_span(closings) < MIN_LOAD_SPAN_NM {
         return Err(format!(
             "the closing runs' loads must span at least {MIN_LOAD_SPAN_NM} N·m to identify the overrunning line"
         ));

@@ -118,22 +118,23 @@ impl PackSettings {
             None => (a * drive_force, "sliding_mu"),
         };
         // A measured line stands for the model's; `a·k` follows its gain, `g₁ = 2a·k/(a·k − 1)`.
-        let (gain, offset, a_k) = match c.overrun_line {
+        let ((gain, gain_from), (offset, offset_from), a_k) = match c.overrun_line {
             Some(l) => {
                 let gain = finite(l.gain, "overrun_line.gain")?;
                 require(gain > 2.0, "overrun_line.gain")?;
+                let offset = positive(l.offset_nm, "overrun_line.offset_nm")?;
                 (
-                    gain,
-                    positive(l.offset_nm, "overrun_line.offset_nm")?,
+                    (gain, "overrun_line.gain"),
+                    (offset, "overrun_line.offset_nm"),
                     gain / (gain - 2.0),
                 )
             }
-            None => (2.0 * a_k / (a_k - 1.0), a * spring / (a_k - 1.0), a_k),
+            None => (
+                (2.0 * a_k / (a_k - 1.0), "sliding_mu"),
+                (a * spring / (a_k - 1.0), "sliding_mu"),
+                a_k,
+            ),
         };
-        let gain_from = c.overrun_line.map_or("sliding_mu", |_| "overrun_line.gain");
-        let offset_from = c
-            .overrun_line
-            .map_or("sliding_mu", |_| "overrun_line.offset_nm");
         let settings = PackSettings {
             spring_force: q16(spring, "mechanism.spring_preload_m")?,
             ramp_factor: scale(ramp, "mechanism.socket_radius_m")?,
