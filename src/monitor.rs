@@ -78,8 +78,9 @@ mod stop;
 
 pub use crate::fx::mul_q16;
 pub use config::{
-    AidingBraking, Config, ConfigError, DrivingPack, ObserverGains, OverrunLine, Thresholds,
-    DEFAULT_BRAKING_MODEL_HZ, DEFAULT_OBSERVER_BANDWIDTH_HZ, DEFAULT_TICK_HZ, POWER_ON_SEED_TICKS,
+    AidingBraking, Config, ConfigError, DrivingPack, LockTimes, ObserverGains, OverrunLine,
+    Thresholds, DEFAULT_BRAKING_MODEL_HZ, DEFAULT_OBSERVER_BANDWIDTH_HZ, DEFAULT_TICK_HZ,
+    POWER_ON_SEED_TICKS,
 };
 pub use io::{BrakeState, Estimate, Flags, Inputs, Scene, SceneModel, ESTIMATE_WORDS};
 pub use scale::{sat_i32, Scale, ScaleError};
@@ -402,6 +403,10 @@ impl State {
         (self.classified, self.observed) = (c, *o);
         if c.just_locked {
             self.checks.locked(x);
+        }
+        if c.lock_against && self.load.alt.is_some() {
+            self.load.settle_against();
+            k.refresh_load(&mut self.load);
         }
         if c.reading_switch {
             self.load.reading_changed();

@@ -18,6 +18,8 @@
 //! The pack's static capacity is not identified: it needs the brake made to slip (a functional
 //! test, issue 17); `capacity_mu` stays at Table 2's μ_s.
 
+mod lock_times;
+
 use crate::accuracy::{run_monitor, scene_trace};
 use noback::fx::{adc_centered, counter_delta};
 use noback::mechanism::Mechanism;
@@ -365,6 +367,9 @@ pub fn commission(runs: &[(&Trace, f64)]) -> Result<Commissioning, String> {
     // The monitor's torque per amp, so that its drive torque reads true.
     config.sensors.motor_torque_constant_nm_a /= gain;
     config.commissioned = true;
+    if relieved {
+        config.lock_times = lock_times::lock_times(&figures, runs, config)?;
+    }
     noback::monitor::Monitor::new(config).map_err(|e| format!("the identified settings: {e}"))?;
     Ok(Commissioning {
         runs: figures,

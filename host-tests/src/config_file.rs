@@ -25,10 +25,15 @@
 //! [monitor.overrun_line]         # a relieved pack's overrunning equilibrium (OverrunLine), both
 //! gain = 6.9
 //! offset_nm = 11.6
+//! [monitor.lock_times]           # a relieved pack's cut-to-lock times (LockTimes), both
+//! along_s = 0.0124
+//! against_s = 0.0164
 //! ```
 
 use noback::monitor::functional_test::TestConfig;
-use noback::monitor::{AidingBraking, Config, DrivingPack, Monitor, OverrunLine, Thresholds};
+use noback::monitor::{
+    AidingBraking, Config, DrivingPack, LockTimes, Monitor, OverrunLine, Thresholds,
+};
 use toml::{Table, Value};
 
 fn number(v: &Value, key: &str) -> Result<f64, String> {
@@ -169,6 +174,11 @@ pub fn parse(text: &str) -> Result<Config, String> {
         let [gain, offset_nm] = all_of(table(t, path)?, path, ["gain", "offset_nm"])?;
         c.overrun_line = Some(OverrunLine { gain, offset_nm });
     }
+    if let Some(t) = m.remove("lock_times") {
+        let path = "monitor.lock_times";
+        let [along_s, against_s] = all_of(table(t, path)?, path, ["along_s", "against_s"])?;
+        c.lock_times = Some(LockTimes { along_s, against_s });
+    }
     for (key, field) in [
         ("capacity_mu", &mut c.capacity_mu),
         ("sliding_mu", &mut c.sliding_mu),
@@ -278,6 +288,12 @@ pub fn write(c: &Config, comment: &str) -> Result<String, String> {
             l.gain, l.offset_nm
         ));
     }
+    if let Some(l) = c.lock_times {
+        out.push_str(&format!(
+            "[monitor.lock_times]\nalong_s = {:?}\nagainst_s = {:?}\n",
+            l.along_s, l.against_s
+        ));
+    }
     match parse(&out) {
         Ok(back) if back == *c => Ok(out),
         Ok(_) => Err("the configuration sets a field the file does not carry".into()),
@@ -322,6 +338,10 @@ mod tests {
         c.overrun_line = Some(OverrunLine {
             gain: 6.125,
             offset_nm: 11.375,
+        });
+        c.lock_times = Some(LockTimes {
+            along_s: 0.0125,
+            against_s: 0.0165,
         });
         let text = write(&c, "test").unwrap();
         assert_eq!(parse(&text), Ok(c), "{text}");

@@ -286,6 +286,24 @@ pub struct OverrunLine {
     pub offset_nm: f64,
 }
 
+/// A relieved pack's time from the drive's cut to the monitor's first lock, measured at
+/// commissioning: the longest of its closings (a load along the motion) and the shortest of its
+/// openings (against it). Where they lie apart it settles the power-on guess at that lock.
+#[cfg_attr(feature = "config-block", derive(serde::Serialize, serde::Deserialize))]
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct LockTimes {
+    /// The closings' longest (s).
+    pub along_s: f64,
+    /// The openings' shortest (s), at least [`LockTimes::MIN_GAP_S`] beyond `along_s`.
+    pub against_s: f64,
+}
+
+impl LockTimes {
+    /// The least gap (s) that leaves each reading a band of one slow-lane period (0.4 ms) at
+    /// a quarter of the gap.
+    pub const MIN_GAP_S: f64 = 0.0016;
+}
+
 /// Everything the monitor is configured with; separate from its state. With `config-block`,
 /// serde writes it as the firmware's configuration block (`config_block`).
 #[cfg_attr(feature = "config-block", derive(serde::Serialize, serde::Deserialize))]
@@ -320,6 +338,8 @@ pub struct Config {
     pub aiding_braking: Option<AidingBraking>,
     /// The overrunning equilibrium, once measured (else `None`: `sliding_mu`'s).
     pub overrun_line: Option<OverrunLine>,
+    /// The cut-to-lock times, once measured (else `None`: the power-on guess stands).
+    pub lock_times: Option<LockTimes>,
     /// The phase-current reading at zero current (A), measured at commissioning with the drive
     /// off; subtracted in whole ADC counts (at most an eighth of full scale).
     pub current_offset_a: f64,
@@ -363,6 +383,7 @@ impl Config {
             driving_drag_nm: None,
             aiding_braking: None,
             overrun_line: None,
+            lock_times: None,
             current_offset_a: 0.0,
             max_catchup_ticks: 8,
             braking_model_hz: DEFAULT_BRAKING_MODEL_HZ,

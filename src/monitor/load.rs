@@ -89,7 +89,8 @@ impl LoadSettings {
 /// The load estimate: learning (from zero at power-on) until the filter has run three time
 /// constants, then known; held with the drive off. Known but *unseen* when last learned aiding
 /// the motion of a spring-only pack, which overruns on almost no drive torque whatever the
-/// load: no estimate resting on it is trusted.
+/// load: no estimate resting on it is trusted. *Settled*: known, its sign read from the first
+/// lock's time (`lock_times`), untrusted until a drive learns it on a decided reading.
 #[cfg_attr(
     feature = "config-block",
     derive(serde::Serialize, serde::Deserialize, Hash)
@@ -99,20 +100,24 @@ pub(crate) enum LoadEstimate {
     Learning(Q16),
     Known(Q16),
     Unseen(Q16),
+    Settled(Q16),
 }
 
 impl LoadEstimate {
     #[inline]
     pub fn value(self) -> Q16 {
         match self {
-            LoadEstimate::Learning(x) | LoadEstimate::Known(x) | LoadEstimate::Unseen(x) => x,
+            LoadEstimate::Learning(x)
+            | LoadEstimate::Known(x)
+            | LoadEstimate::Unseen(x)
+            | LoadEstimate::Settled(x) => x,
         }
     }
 
     #[inline]
     pub fn known(self) -> Option<Q16> {
         match self {
-            LoadEstimate::Known(x) | LoadEstimate::Unseen(x) => Some(x),
+            LoadEstimate::Known(x) | LoadEstimate::Unseen(x) | LoadEstimate::Settled(x) => Some(x),
             LoadEstimate::Learning(_) => None,
         }
     }
@@ -218,7 +223,7 @@ impl Load {
                 true
             }
             LoadEstimate::Learning(_) => false,
-            LoadEstimate::Known(_) | LoadEstimate::Unseen(_) => true,
+            LoadEstimate::Known(_) | LoadEstimate::Unseen(_) | LoadEstimate::Settled(_) => true,
         };
         self.estimate = match (known, unseen) {
             (false, _) => LoadEstimate::Learning(value),
@@ -247,6 +252,18 @@ impl Load {
     /// learning counts on (trust also needs the load seen, [`Load::trusted`]).
     pub fn decided(&self) -> bool {
         self.estimate.known().is_some() && self.alt.is_none()
+    }
+
+    /// The first lock after a cut put a guessed load against the motion (`lock_times`): the
+    /// driving reading's load stands, settled, its sign no longer a guess. Its size carries the
+    /// drag's error, large beside a light load: untrusted.
+    pub fn settle_against(&mut self) {
+        if let Some(alt) = self.alt.take() {
+            self.estimate = match self.estimate {
+                LoadEstimate::Learning(_) => LoadEstimate::Learning(alt),
+                _ => LoadEstimate::Settled(alt),
+            };
+        }
     }
 
     /// The load is known but unseen ([`LoadEstimate::Unseen`]).

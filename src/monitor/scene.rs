@@ -19,8 +19,8 @@
 //! |---|---|---|---|
 //! | shafts' travel per window, averaged | `i32` counts × 32, saturating | ±2^26 counts a window | 1/32 count |
 
-use super::config::{Config, ConfigError, DrivingPack};
-use super::convert::{counts, positive, q16, ticks};
+use super::config::{Config, ConfigError, DrivingPack, LockTimes};
+use super::convert::{counts, positive, q16, require, ticks};
 use super::estimate::ModelCapacity;
 use super::load::LoadEstimate;
 use super::observe::Observed;
@@ -31,6 +31,10 @@ use super::sense::Sensed;
 use super::stop::{Motion, StopSettings, Turn};
 use super::{convert::scale, Scene};
 use crate::fx::{counter_delta, Q16};
+
+/// `Classify::since_cut` with no cut awaiting its first lock (a count saturates there too:
+/// a lock 5 days after its cut is not timed).
+const NO_CUT: u32 = u32::MAX;
 
 /// Windows each shaft's travel is averaged over (51 ms at 10 kHz): a power of two.
 const AHEAD_SHIFT: u32 = 5;
@@ -61,6 +65,10 @@ pub(crate) struct SceneSettings {
     /// With no load known, take the overrunning reading (a relieved pack: its overrunning
     /// drive torque lies above the drag); a spring-only pack overruns on almost none.
     overrun_when_unknown: bool,
+    /// A first lock after a cut this many ticks or more after it puts the load against the
+    /// motion (`Config::lock_times`: a quarter of the gap short of the openings' shortest; 0:
+    /// none given).
+    lock_against_ticks: u32,
 }
 
 impl SceneSettings {
@@ -96,6 +104,14 @@ impl SceneSettings {
                 "thresholds.stick_speed_rad_s",
             )?,
             overrun_when_unknown: c.driving_pack == DrivingPack::Relieved,
+            lock_against_ticks: match c.lock_times {
+                Some(l) => {
+                    let gap = l.against_s - l.along_s;
+                    require(l.along_s > 0.0 && gap >= LockTimes::MIN_GAP_S, "lock_times")?;
+                    ticks(l.against_s - gap / 4.0, tick_hz, "lock_times")?
+                }
+                None => 0,
+            },
         })
     }
 }
@@ -153,6 +169,9 @@ pub(crate) struct Classified {
     pub reading_switch: bool,
     /// The brake locked this call.
     pub just_locked: bool,
+    /// The first lock since the cut came late enough (`lock_times`) to put the load against
+    /// the motion.
+    pub lock_against: bool,
     /// A spring-only pack's ramps open (`F = F_s`): cut against the load, not clamped since.
     pub ramps_open: bool,
     /// The scene has lasted `engage_settle_s`.
@@ -178,6 +197,7 @@ impl Classified {
         guessed: false,
         reading_switch: false,
         just_locked: false,
+        lock_against: false,
         ramps_open: false,
         phase_settled: false,
         steady_for_learning: false,
@@ -216,6 +236,8 @@ pub(crate) struct Classify {
     input_gaining: bool,
     /// Ticks since the last classification.
     since: u32,
+    /// Ticks since the drive's cut, until the first lock after it ([`NO_CUT`] otherwise).
+    since_cut: u32,
     turn: Turn,
 }
 
@@ -234,6 +256,7 @@ impl Classify {
             sync_motor: 0,
             input_gaining: false,
             since: 0,
+            since_cut: NO_CUT,
             turn: Turn::None,
         }
     }
@@ -243,6 +266,7 @@ impl Classify {
     /// waits for the next classification).
     pub fn tick(&mut self, x: &Sensed, o: &Observed) {
         self.since = self.since.saturating_add(x.n);
+        self.since_cut = self.since_cut.saturating_add(x.n);
         if x.first {
             (self.sync_out, self.sync_motor) = (x.out, x.motor);
         }
@@ -253,8 +277,10 @@ impl Classify {
             (self.steady_ticks, self.input_gaining) = (0, false);
             self.phase = if x.drive {
                 (self.ahead_motor, self.ahead_out) = (0, 0);
+                self.since_cut = NO_CUT;
                 Phase::Driving(Reading::none())
             } else {
+                self.since_cut = 0;
                 Phase::Braking
             };
         }
@@ -284,6 +310,7 @@ impl Classify {
         // motion (then the reading is settled and the product is skipped).
         let mut overrun_torque = Q16::ZERO;
         let mut just_locked = false;
+        let mut lock_against = false;
         let prev = self.phase;
         if x.drive {
             let against = dir
@@ -337,6 +364,9 @@ impl Classify {
                     Phase::Holding => Phase::Holding,
                     _ if self.turn.stops(&k.stop, &mut self.stick_ticks, &m) => {
                         just_locked = true;
+                        let t = core::mem::replace(&mut self.since_cut, NO_CUT);
+                        lock_against =
+                            k.lock_against_ticks != 0 && t != NO_CUT && t >= k.lock_against_ticks;
                         Phase::Holding
                     }
                     _ => Phase::Braking,
@@ -377,6 +407,7 @@ impl Classify {
             guessed: matches!(self.phase, Phase::Driving(r) if r.overrunning && r.guessed),
             reading_switch,
             just_locked,
+            lock_against,
             ramps_open: self.turn.ramps_open(),
             phase_settled: self.phase_ticks >= k.engage_settle_ticks,
             steady_for_learning,

@@ -148,6 +148,10 @@ pub fn main(a: &CommissionArgs) -> Result<i32, String> {
                     "gain": l.gain,
                     "offset_nm": l.offset_nm,
                 })),
+                "lock_times": c.config.lock_times.map(|l| json!({
+                    "along_s": l.along_s,
+                    "against_s": l.against_s,
+                })),
                 "config_file": text,
             })
         );

@@ -70,3 +70,29 @@ fn an_input_gaining_on_the_output_faster_than_the_stick_speed_ran_ahead() {
     drive(&mut cl, (5.5, 5.0), 128, at);
     assert!(!cl.input_ran_ahead(&k));
 }
+
+#[test]
+fn lock_times_give_a_late_lock_a_quarter_of_the_gap_short_of_the_openings() {
+    let set = |along_s, against_s| {
+        SceneSettings::new(
+            &Config {
+                lock_times: Some(LockTimes { along_s, against_s }),
+                ..Config::default()
+            },
+            1,
+        )
+        .map(|k| k.lock_against_ticks)
+    };
+    // 12 and 16 ms at 10 kHz: against from 15 ms.
+    assert_eq!(set(0.012, 0.016), Ok(150));
+    let refused = Err(ConfigError::OutOfRange {
+        parameter: "lock_times",
+    });
+    assert_eq!(set(0.012, 0.0135), refused, "closer than MIN_GAP_S");
+    assert_eq!(set(0.0, 0.016), refused);
+    assert_eq!(set(f64::NAN, 0.016), refused);
+    assert_eq!(
+        SceneSettings::new(&Config::default(), 1).map(|k| k.lock_against_ticks),
+        Ok(0)
+    );
+}

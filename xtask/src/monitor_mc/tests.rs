@@ -1,6 +1,7 @@
 //! A campaign cut into 2 or 3 shards, each run on a different number of threads and merged in
 //! any order, gives the unsharded campaign's report and page byte for byte; merge refuses parts
-//! that do not belong together; the per-form report counts each kind's dormant runs.
+//! that do not belong together; the per-form report counts each kind's dormant runs; the
+//! committed certification campaign is of this build's configuration.
 
 use super::*;
 
@@ -216,4 +217,26 @@ fn a_fault_run_that_never_manifests_counts_as_dormant_in_its_form_only() {
     assert_eq!(v["paper"]["detection"]["PackWear"]["of"][1], 1);
     assert_eq!(v["physical"]["dormant"]["PackWear"], 1);
     assert_eq!(v["physical"]["dormant"]["Drag"], 0);
+}
+
+/// The committed certification campaign was run on the configuration this build ships for its
+/// family: a change to `Config` (its `Debug` text) without a rerun of the campaign fails here.
+#[test]
+fn the_committed_campaign_is_of_this_builds_configuration() {
+    let path = crate::shell::workspace_root().join(page::CAMPAIGN_RECORD);
+    let text = std::fs::read_to_string(&path).expect("the committed campaign record");
+    let c: serde_json::Value = serde_json::from_str(&text).expect("campaign JSON");
+    let family = c["plant_family"]
+        .as_str()
+        .and_then(Family::parse)
+        .expect("its plant family");
+    assert_eq!(
+        c["config_digest"].as_str(),
+        Some(part::config_digest(&family.config()).as_str()),
+        "rerun the campaign (docs/monitor.md, \"Certification-scale nominal campaign\")"
+    );
+    assert!(
+        c["measured_on"].is_null(),
+        "the record names an earlier monitor"
+    );
 }
