@@ -405,12 +405,15 @@ fn a_light_opening_load_is_read_at_its_late_lock() {
             continue;
         };
         let trace = draw_trace(&d).unwrap();
-        let last = |c: Config| *run_monitor(&trace, c).unwrap().last().unwrap();
+        let with = run_monitor(&trace, unit.config).unwrap();
         let without = Config {
             lock_times: None,
             ..unit.config
         };
-        let (read, guessed) = (last(unit.config), last(without));
+        let (read, guessed) = (
+            *with.last().unwrap(),
+            *run_monitor(&trace, without).unwrap().last().unwrap(),
+        );
         println!(
             "draw {i}: {:?} {} N·m, lock times {times:?}: load {} (without: {}), trusted {}",
             d.scene.kind,
@@ -424,7 +427,7 @@ fn a_light_opening_load_is_read_at_its_late_lock() {
             assert_eq!(read.load_torque_nm, guessed.load_torque_nm, "draw {i}");
         } else if !guessed.trusted {
             openings += 1;
-            let err = compare(&trace, &run_monitor(&trace, unit.config).unwrap())
+            let err = compare(&trace, &with)
                 .holding_torque_err_pct()
                 .unwrap_or(f64::INFINITY);
             // Settled, not trusted: a light load's size carries the drag's error (2.3–3.5 % on
