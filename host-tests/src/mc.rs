@@ -394,4 +394,6 @@ impl Draw {
 }
 
 mod run;
-pub use run::{commission_draw, evaluate, run_all, Campaign, TEST_EVERY};
+pub use run::{
+    behaviour_digest, commission_draw, evaluate, run_all, Campaign, BEHAVIOUR_RUNS, TEST_EVERY,
+};

@@ -12,7 +12,10 @@ mod throughput;
 use crate::shell::workspace_root;
 use clap::{Args, Parser, Subcommand};
 use host_tests::family::Family;
-use host_tests::mc::{draw_in, draw_legacy, run_all, Campaign as Setup, Draw, FAULT_KINDS};
+use host_tests::mc::{
+    behaviour_digest, draw_in, draw_legacy, run_all, Campaign as Setup, Draw, BEHAVIOUR_RUNS,
+    FAULT_KINDS,
+};
 use part::{Campaign, Part};
 use std::io::Write as _;
 use std::ops::Range;
@@ -259,12 +262,21 @@ fn forms_of(campaign: &Campaign) -> Vec<&'static str> {
         .collect()
 }
 
+/// [`behaviour_digest`] of a campaign's first nominal draws (at most [`BEHAVIOUR_RUNS`]).
+pub fn monitor_digest(setup: &Setup, campaign: &Campaign) -> Result<String, String> {
+    let draws: Vec<_> = (0..campaign.runs.min(BEHAVIOUR_RUNS))
+        .map(|i| draw_for(&campaign.plant_family, campaign.seed, i, None))
+        .collect();
+    Ok(format!("{:#010x}", behaviour_digest(&draws, setup)?))
+}
+
 /// The campaign a run's arguments describe.
 fn campaign_of(setup: &Setup, family: Family, seed: u64, runs: u64, fault_runs: u64) -> Campaign {
     Campaign {
         seed,
         plant_family: family.name().into(),
         config_digest: part::config_digest(&setup.config),
+        monitor_digest: None,
         pre_roll_s: setup.pre_roll_s,
         power_on_settle_s: setup.config.thresholds.power_on_settle_s,
         runs,
@@ -292,6 +304,7 @@ fn run_main(a: &RunArgs) -> Result<(), Fail> {
     if a.legacy_draws {
         campaign.plant_family = LEGACY_FAMILY.into();
     }
+    campaign.monitor_digest = Some(monitor_digest(&setup, &campaign)?);
     let (k, n) = a.shard.unwrap_or((0, 1));
     let part = run_part(&setup, campaign, k, n, threads(a.threads));
     let text = serde_json::to_string(&part).map_err(|e| e.to_string())?;
@@ -342,6 +355,14 @@ fn merge_main(m: &MergeArgs) -> Result<(), Fail> {
                 "{name}: configuration digest {} is not this build's monitor's ({digest})",
                 p.campaign.config_digest
             )));
+        }
+        if let Some(recorded) = &p.campaign.monitor_digest {
+            let digest = monitor_digest(&setup, &p.campaign)?;
+            if *recorded != digest {
+                return Err(Fail::Input(format!(
+                    "{name}: monitor digest {recorded} is not this build's monitor's ({digest})"
+                )));
+            }
         }
     }
     // The page describes the default family's campaign drawn by today's stream.
@@ -394,16 +415,13 @@ fn finish(
     Ok(())
 }
 
-/// The report (JSON text) of the shipped monitor's unsharded campaign, as `--json` prints it.
+/// The report (JSON text) of the shipped monitor's unsharded campaign, as `--json` prints it
+/// (with its behaviour digest, as `run_main` gives it).
 pub fn unsharded_report(seed: u64, runs: u64, fault_runs: u64) -> Result<String, String> {
     let setup = Setup::default();
-    let part = run_part(
-        &setup,
-        campaign_of(&setup, Family::PhysicalDefault, seed, runs, fault_runs),
-        0,
-        1,
-        threads(None),
-    );
+    let mut campaign = campaign_of(&setup, Family::PhysicalDefault, seed, runs, fault_runs);
+    campaign.monitor_digest = Some(monitor_digest(&setup, &campaign)?);
+    let part = run_part(&setup, campaign, 0, 1, threads(None));
     let part: Part =
         serde_json::from_str(&serde_json::to_string(&part).map_err(|e| e.to_string())?)
             .map_err(|e| e.to_string())?;
@@ -423,6 +441,7 @@ pub fn report_of(
         fault_runs: campaign.fault_runs,
         plant_family: campaign.plant_family.clone(),
         config_digest: campaign.config_digest.clone(),
+        monitor_digest: campaign.monitor_digest.clone(),
         config: setup.config,
         pre_roll_s: campaign.pre_roll_s,
         commissioned: campaign.commissioned,

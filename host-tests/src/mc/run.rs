@@ -8,6 +8,7 @@ use crate::accuracy::{
 };
 use crate::dormant::functional_test_after;
 use crate::family::Family;
+use noback::digest::Fnv1a;
 use noback::monitor::Config;
 use noback_twin::scene::SceneKind;
 use std::sync::atomic::{AtomicUsize, Ordering};
@@ -42,6 +43,39 @@ impl Campaign {
     }
 }
 
+impl Campaign {
+    /// The configuration draw `d`'s monitor runs on, and whether acceptance refused its unit.
+    /// It is configured with the nominal Table 2, not the drawn mechanism: it must cope with a
+    /// ±10 % real part (commissioned: with what its acceptance runs identified).
+    pub fn config_for(&self, d: &Draw) -> (Config, bool) {
+        match self.commissioned.then(|| commission_draw(d)) {
+            Some(Ok(c)) => (c.config, false),
+            Some(Err(_)) => (self.config, true),
+            None => (self.config, false),
+        }
+    }
+}
+
+/// Nominal draws [`behaviour_digest`] runs.
+pub const BEHAVIOUR_RUNS: u64 = 8;
+
+/// The monitor's behaviour in a campaign: FNV-1a over every estimate's words, without and
+/// with the current command, on `draws` run as [`evaluate`] runs them. A configuration digest
+/// does not change with the monitor's code; this does, on any draw the code treats otherwise.
+pub fn behaviour_digest(draws: &[Draw], campaign: &Campaign) -> Result<u32, String> {
+    let mut digest = Fnv1a::new();
+    for d in draws {
+        let trace = draw_trace_after(d, campaign.pre_roll_s)?;
+        let (config, _) = campaign.config_for(d);
+        for command in [false, true] {
+            for e in run_monitor_with(&trace, config, command)? {
+                e.to_words().into_iter().for_each(|w| digest.push(w));
+            }
+        }
+    }
+    Ok(digest.value())
+}
+
 impl Default for Campaign {
     /// The default family's campaign.
     fn default() -> Self {
@@ -63,13 +97,7 @@ pub fn evaluate(d: &Draw, campaign: &Campaign) -> Outcome {
         Ok(trace) => trace,
         Err(e) => return fail(e),
     };
-    // The monitor is configured with the nominal Table 2, not the drawn mechanism: it must
-    // cope with a ±10 % real part (commissioned: with what its acceptance runs identified).
-    let (config, refused) = match campaign.commissioned.then(|| commission_draw(d)) {
-        Some(Ok(c)) => (c.config, false),
-        Some(Err(_)) => (campaign.config, true),
-        None => (campaign.config, false),
-    };
+    let (config, refused) = campaign.config_for(d);
     let estimates = match run_monitor(&trace, config) {
         Ok(e) => e,
         Err(e) => return fail(e),

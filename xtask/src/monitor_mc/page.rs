@@ -316,11 +316,12 @@ fn campaign_section(record: Option<&Value>) -> String {
         .unwrap_or("an evaluation seed: no threshold was tuned on it");
     format!(
         "Seed {} ({seed_note}), plant family `{}`, monitor \
-         configuration digest {}{stale}. Planned: {planned} nominal runs in {shards} shards on this \
+         configuration digest {}, behaviour digest {}{stale}. Planned: {planned} nominal runs in {shards} shards on this \
          machine; {done}:\n\n```sh\n{}\n```\n\n{}{}\n{}",
         c["seed"],
         c["plant_family"].as_str().unwrap_or(""),
         c["config_digest"].as_str().unwrap_or(""),
+        c["monitor_digest"].as_str().unwrap_or("none"),
         campaign_command(runs),
         false_alarm_line(c),
         command_line(c),

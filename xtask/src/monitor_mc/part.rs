@@ -1,6 +1,7 @@
 //! A shard's result file and the merge of shards: each part records the campaign it belongs to
-//! (seed, plant family, the monitor's configuration digest, pre-roll, the campaign's size) and
-//! the runs it covers; merge refuses parts that do not belong together, overlap or leave gaps.
+//! (seed, plant family, the monitor's configuration and behaviour digests, pre-roll, the
+//! campaign's size) and the runs it covers; merge refuses parts that do not belong together,
+//! overlap or leave gaps.
 
 use host_tests::dormant::Verdict;
 use host_tests::mc::{Context, Outcome, FAULT_KINDS};
@@ -18,6 +19,10 @@ pub struct Campaign {
     pub seed: u64,
     pub plant_family: String,
     pub config_digest: String,
+    /// The monitor's behaviour digest ([`host_tests::mc::behaviour_digest`]): what the
+    /// configuration digest misses, a change of the monitor's code.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub monitor_digest: Option<String>,
     pub pre_roll_s: f64,
     /// The monitor's settling after a seeded power-on (s), the one setting an ablation changes.
     pub power_on_settle_s: f64,
@@ -299,6 +304,14 @@ fn check(name: &str, p: &Part, first: &(String, Campaign)) -> Result<(), String>
             "configuration digest",
             c.config_digest.clone(),
             f.config_digest.clone(),
+        );
+    }
+    if c.monitor_digest != f.monitor_digest {
+        let text = |d: &Option<String>| d.clone().unwrap_or_else(|| "none".into());
+        return differs(
+            "monitor digest",
+            text(&c.monitor_digest),
+            text(&f.monitor_digest),
         );
     }
     if c.power_on_settle_s.to_bits() != f.power_on_settle_s.to_bits() {

@@ -29,6 +29,8 @@ pub struct Meta {
     pub fault_runs: u64,
     pub plant_family: String,
     pub config_digest: String,
+    /// The monitor's behaviour digest, when the campaign recorded one.
+    pub monitor_digest: Option<String>,
     pub config: Config,
     pub pre_roll_s: f64,
     /// Each draw's unit commissioned on its acceptance runs.
@@ -155,6 +157,7 @@ pub fn build(meta: &Meta, outcomes: &[Outcome]) -> Result<Value, String> {
         "fault_runs": meta.fault_runs,
         "plant_family": meta.plant_family,
         "config_digest": meta.config_digest,
+        "monitor_digest": meta.monitor_digest,
         "power_on_settle_s": meta.config.thresholds.power_on_settle_s,
         "pre_roll_s": meta.pre_roll_s,
         "nominal_runs": nominal.len(),

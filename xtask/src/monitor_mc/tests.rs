@@ -1,7 +1,7 @@
 //! A campaign cut into 2 or 3 shards, each run on a different number of threads and merged in
 //! any order, gives the unsharded campaign's report and page byte for byte; merge refuses parts
 //! that do not belong together; the per-form report counts each kind's dormant runs; the
-//! committed certification campaign is of this build's configuration.
+//! committed certification campaign is of this build's configuration and monitor.
 
 use super::*;
 
@@ -168,6 +168,15 @@ fn merge_refuses_parts_that_do_not_belong_together() {
         ],
         "e: configuration digest",
     );
+    let mut code = c.clone();
+    code.monitor_digest = Some("0x00000000".into());
+    refused(
+        &[
+            ("a".into(), a.clone()),
+            ("m".into(), empty(&code, 4..RUNS, 1..FAULT_RUNS)),
+        ],
+        "m: monitor digest",
+    );
     refused(
         &[
             ("a".into(), a.clone()),
@@ -220,7 +229,8 @@ fn a_fault_run_that_never_manifests_counts_as_dormant_in_its_form_only() {
 }
 
 /// The committed certification campaign was run on the configuration this build ships for its
-/// family: a change to `Config` (its `Debug` text) without a rerun of the campaign fails here.
+/// family and on this build's monitor: a change to `Config` (its `Debug` text), or to what the
+/// monitor does on the campaign's first draws, without a rerun of the campaign fails here.
 #[test]
 fn the_committed_campaign_is_of_this_builds_configuration() {
     let path = crate::shell::workspace_root().join(page::CAMPAIGN_RECORD);
@@ -238,5 +248,17 @@ fn the_committed_campaign_is_of_this_builds_configuration() {
     assert!(
         c["measured_on"].is_null(),
         "the record names an earlier monitor"
+    );
+    let mut setup = Setup::for_family(family);
+    setup.pre_roll_s = c["pre_roll_s"].as_f64().expect("pre-roll");
+    setup.config.thresholds.power_on_settle_s = c["power_on_settle_s"].as_f64().expect("settling");
+    setup.commissioned = !c["commissioning_refused_runs"].is_null();
+    let seed = c["seed"].as_u64().expect("seed");
+    let runs = c["runs"].as_u64().expect("runs");
+    let campaign = campaign_of(&setup, family, seed, runs, 0);
+    assert_eq!(
+        c["monitor_digest"].as_str(),
+        Some(monitor_digest(&setup, &campaign).expect("digest").as_str()),
+        "the monitor's code changed since the campaign: rerun it"
     );
 }
