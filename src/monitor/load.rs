@@ -77,7 +77,7 @@ impl LoadSettings {
     }
 
     /// The load filter's gain after `learned` ticks of learning: the running mean's `1/k` over
-    /// its first `k` slow-lane calls while that exceeds `alpha`, so the estimate starts from its
+    /// its first `k` slow-lane slots while that exceeds `alpha`, so the estimate starts from its
     /// first sample instead of zero and carries no start-up bias when it becomes known.
     fn gain(&self, learned: u32) -> Gain {
         let k = learned / SLOW.ticks + 1;

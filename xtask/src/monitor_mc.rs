@@ -263,11 +263,11 @@ fn forms_of(campaign: &Campaign) -> Vec<&'static str> {
 }
 
 /// [`behaviour_digest`] of a campaign's first nominal draws (at most [`BEHAVIOUR_RUNS`]).
-pub fn monitor_digest(setup: &Setup, campaign: &Campaign) -> Result<String, String> {
+pub fn monitor_digest(setup: &Setup, campaign: &Campaign) -> String {
     let draws: Vec<_> = (0..campaign.runs.min(BEHAVIOUR_RUNS))
         .map(|i| draw_for(&campaign.plant_family, campaign.seed, i, None))
         .collect();
-    Ok(format!("{:#010x}", behaviour_digest(&draws, setup)?))
+    format!("{:#010x}", behaviour_digest(&draws, setup))
 }
 
 /// The campaign a run's arguments describe.
@@ -304,7 +304,7 @@ fn run_main(a: &RunArgs) -> Result<(), Fail> {
     if a.legacy_draws {
         campaign.plant_family = LEGACY_FAMILY.into();
     }
-    campaign.monitor_digest = Some(monitor_digest(&setup, &campaign)?);
+    campaign.monitor_digest = Some(monitor_digest(&setup, &campaign));
     let (k, n) = a.shard.unwrap_or((0, 1));
     let part = run_part(&setup, campaign, k, n, threads(a.threads));
     let text = serde_json::to_string(&part).map_err(|e| e.to_string())?;
@@ -356,12 +356,18 @@ fn merge_main(m: &MergeArgs) -> Result<(), Fail> {
                 p.campaign.config_digest
             )));
         }
-        if let Some(recorded) = &p.campaign.monitor_digest {
-            let digest = monitor_digest(&setup, &p.campaign)?;
-            if *recorded != digest {
+        let digest = monitor_digest(&setup, &p.campaign);
+        match &p.campaign.monitor_digest {
+            Some(recorded) if *recorded == digest => {}
+            Some(recorded) => {
                 return Err(Fail::Input(format!(
                     "{name}: monitor digest {recorded} is not this build's monitor's ({digest})"
-                )));
+                )))
+            }
+            None => {
+                return Err(Fail::Input(format!(
+                    "{name}: no monitor digest (a part of an earlier build): rerun it"
+                )))
             }
         }
     }
@@ -420,7 +426,7 @@ fn finish(
 pub fn unsharded_report(seed: u64, runs: u64, fault_runs: u64) -> Result<String, String> {
     let setup = Setup::default();
     let mut campaign = campaign_of(&setup, Family::PhysicalDefault, seed, runs, fault_runs);
-    campaign.monitor_digest = Some(monitor_digest(&setup, &campaign)?);
+    campaign.monitor_digest = Some(monitor_digest(&setup, &campaign));
     let part = run_part(&setup, campaign, 0, 1, threads(None));
     let part: Part =
         serde_json::from_str(&serde_json::to_string(&part).map_err(|e| e.to_string())?)

@@ -60,20 +60,29 @@ impl Campaign {
 pub const BEHAVIOUR_RUNS: u64 = 8;
 
 /// The monitor's behaviour in a campaign: FNV-1a over every estimate's words, without and
-/// with the current command, on `draws` run as [`evaluate`] runs them. A configuration digest
-/// does not change with the monitor's code; this does, on any draw the code treats otherwise.
-pub fn behaviour_digest(draws: &[Draw], campaign: &Campaign) -> Result<u32, String> {
+/// with the current command, on `draws` run as [`evaluate`] runs them; a run that fails folds
+/// in its error's text, as `evaluate` counts it. Unlike a configuration digest, this changes
+/// with the monitor's code, on any draw the code treats otherwise.
+pub fn behaviour_digest(draws: &[Draw], campaign: &Campaign) -> u32 {
     let mut digest = Fnv1a::new();
     for d in draws {
-        let trace = draw_trace_after(d, campaign.pre_roll_s)?;
         let (config, _) = campaign.config_for(d);
-        for command in [false, true] {
-            for e in run_monitor_with(&trace, config, command)? {
-                e.to_words().into_iter().for_each(|w| digest.push(w));
-            }
+        let runs = draw_trace_after(d, campaign.pre_roll_s).and_then(|trace| {
+            [false, true]
+                .map(|command| run_monitor_with(&trace, config, command))
+                .into_iter()
+                .collect::<Result<Vec<_>, _>>()
+        });
+        match runs {
+            Ok(runs) => runs
+                .iter()
+                .flatten()
+                .flat_map(|e| e.to_words())
+                .for_each(|w| digest.push(w)),
+            Err(e) => e.bytes().for_each(|b| digest.push_byte(b)),
         }
     }
-    Ok(digest.value())
+    digest.value()
 }
 
 impl Default for Campaign {
