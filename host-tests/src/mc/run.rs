@@ -41,9 +41,7 @@ impl Campaign {
             commissioned: false,
         }
     }
-}
 
-impl Campaign {
     /// The configuration draw `d`'s monitor runs on, and whether acceptance refused its unit.
     /// It is configured with the nominal Table 2, not the drawn mechanism: it must cope with a
     /// ±10 % real part (commissioned: with what its acceptance runs identified).
