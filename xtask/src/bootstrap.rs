@@ -4,7 +4,7 @@
 //! `RUSTUP_AUTO_INSTALL=0` on our machines means `rust-toolchain.toml` installs nothing by
 //! itself, so the xtask adds missing targets. QEMU comes from Debian's packages, installed only
 //! when missing and when we are root; otherwise we stop and name the package. A second run
-//! only checks.
+//! only checks. Installers print to stderr: stdout stays the command's own (`--json`).
 
 use crate::cores::Core;
 use crate::shell::{self, workspace_root};
@@ -37,7 +37,8 @@ pub fn ensure_targets() -> Result<(), String> {
         Command::new("rustup")
             .args(["target", "add"])
             .args(&missing)
-            .current_dir(workspace_root()),
+            .current_dir(workspace_root())
+            .stdout(std::io::stderr()),
     )
 }
 
@@ -109,12 +110,18 @@ fn apt_install(packages: &[&str], what: &str) -> Result<(), String> {
     eprintln!("bootstrap: {what} is missing; installing {list} from Debian's packages");
     let quiet = [("DEBIAN_FRONTEND", "noninteractive")];
     if !UPDATED.swap(true, std::sync::atomic::Ordering::Relaxed) {
-        shell::run(Command::new("apt-get").arg("update").envs(quiet))?;
+        shell::run(
+            Command::new("apt-get")
+                .arg("update")
+                .envs(quiet)
+                .stdout(std::io::stderr()),
+        )?;
     }
     shell::run(
         Command::new("apt-get")
             .args(["install", "-y", "--no-install-recommends"])
             .args(packages)
-            .envs(quiet),
+            .envs(quiet)
+            .stdout(std::io::stderr()),
     )
 }

@@ -5,7 +5,9 @@
 //! less that braking. A lag starts when the output falls behind on the counters and on the
 //! observer's speed, and lasts until it overtakes the input; it arms once `J_s·ω̇` has held
 //! still for the persistence time (the observer still tracking an engagement's braking is no
-//! reference). A fall of `J_s·ω̇` by more than the drag allowance for the persistence time is
+//! reference). A lag from a level run of the persistence time (the output tracking its input,
+//! the pack holding the load) arms at once on that run's `J_s·ω̇`: falling behind opens the
+//! ramps. A fall of `J_s·ω̇` by more than the drag allowance for the persistence time is
 //! then a pack that drags. This is where the drive checks see nothing: the paper reading's
 //! continuous closing, whose drive leads the door with no torque at all.
 //!
@@ -13,6 +15,7 @@
 //! |---|---|---|---|
 //! | `J_s·ω̇` along the motion, its reference | [`Q16`] N·m, saturating | ±32 768 N·m | 1.5e-5 N·m |
 //! | lag and fall counts | `u32` ticks, saturating | 0 … 2^32 − 1 | 0.1 ms |
+//! | level run | `u8` calls, saturating | 0 … 255 (102 ms) | 0.4 ms |
 
 use super::drive::{follow, DriveSettings};
 use crate::fx::Q16;
@@ -58,6 +61,9 @@ pub(crate) struct Lagging {
     out: u32,
     /// Calls since the output counter last moved.
     still_calls: u8,
+    /// Calls the output has run level with its input (neither lagging nor ahead), `reference`
+    /// following `J_s·ω̇` meanwhile.
+    level_calls: u8,
 }
 
 /// Calls the output counter may stand still and the fall still count (1.2 ms: ≥ 1 count at
@@ -79,12 +85,25 @@ impl Lagging {
         let started = self.lag_ticks > 0;
         let starts = t.lagging && lag > t.stick_speed;
         let ahead = lag < t.stick_speed.saturating_neg();
+        let along = t.dir.apply(t.accel_torque);
         if t.dir != self.dir || ahead || !(started || starts) {
+            // Level with its input: its `J_s·ω̇` is followed as a lag's reference.
+            let level = t.dir == self.dir && !ahead;
+            let (calls, reference) = match self.level_calls {
+                0 => (1, along),
+                n => (
+                    n.saturating_add(1),
+                    follow(self.reference, along, p.reference_shift()),
+                ),
+            };
             *self = Lagging {
                 dir: t.dir,
                 out: t.out,
                 ..Lagging::default()
             };
+            if level {
+                (self.reference, self.level_calls) = (reference, calls);
+            }
             return false;
         }
         self.still_calls = if t.out == self.out {
@@ -93,8 +112,11 @@ impl Lagging {
             0
         };
         self.out = t.out;
-        let along = t.dir.apply(t.accel_torque);
         let counted = SLOW.covered(t.ticks);
+        // A lag from a level run: armed at once, on the run's `J_s·ω̇`.
+        if self.lag_ticks == 0 && u32::from(self.level_calls) > p.persistence_ticks() / SLOW.ticks {
+            self.lag_ticks = p.persistence_ticks().saturating_add(1);
+        }
         let armed = self.lag_ticks > p.persistence_ticks();
         // Arming waits for `J_s·ω̇` to hold still: an engagement's braking the observer is
         // still tracking when the output falls behind would read as a fall.
@@ -253,6 +275,23 @@ mod tests {
         let raised =
             (0..persistence_calls(&p)).any(|_| call(&mut check, &p, true, -61.0 - allowance, 5));
         assert!(raised);
+    }
+
+    #[test]
+    fn a_fall_behind_a_level_run_is_a_drag_at_once_and_behind_a_passing_level_waits() {
+        // The output tracks its input (`J_s·ω̇` ≈ 0) until a drag brakes it behind: the run's
+        // `J_s·ω̇` is the reference. An output only passing level (from ahead) sets none.
+        let p = params();
+        let allowance = p.drag_allowance().to_num::<f64>();
+        for (level_calls, drag) in [(2 * persistence_calls(&p), true), (3, false)] {
+            let mut check = Lagging::default();
+            for _ in 0..level_calls {
+                assert!(!at_speed(&mut check, &p, false, 10.0, 0.0));
+            }
+            let raised = (0..persistence_calls(&p))
+                .any(|_| at_speed(&mut check, &p, true, 9.0, -1.0 - allowance));
+            assert_eq!(raised, drag, "{level_calls} level calls");
+        }
     }
 
     #[test]
