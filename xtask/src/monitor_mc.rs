@@ -338,39 +338,12 @@ fn merge_main(m: &MergeArgs) -> Result<(), Fail> {
             .map_err(|e| Fail::Input(format!("{name}: not a monitor-mc part file ({e})")))?;
         parts.push((name, part));
     }
-    // The setup the parts were run with, which must be this build's monitor.
     let family = parts
         .first()
         .and_then(|(_, p)| Family::parse(&p.campaign.plant_family))
         .unwrap_or(Family::PhysicalDefault);
     let shipped = Setup::for_family(family);
-    let mut setup = shipped;
-    if let Some((name, p)) = parts.first() {
-        setup.pre_roll_s = p.campaign.pre_roll_s;
-        setup.config.thresholds.power_on_settle_s = p.campaign.power_on_settle_s;
-        setup.commissioned = p.campaign.commissioned;
-        let digest = part::config_digest(&setup.config);
-        if p.campaign.config_digest != digest {
-            return Err(Fail::Input(format!(
-                "{name}: configuration digest {} is not this build's monitor's ({digest})",
-                p.campaign.config_digest
-            )));
-        }
-        let digest = monitor_digest(&setup, &p.campaign);
-        match &p.campaign.monitor_digest {
-            Some(recorded) if *recorded == digest => {}
-            Some(recorded) => {
-                return Err(Fail::Input(format!(
-                    "{name}: monitor digest {recorded} is not this build's monitor's ({digest})"
-                )))
-            }
-            None => {
-                return Err(Fail::Input(format!(
-                    "{name}: no monitor digest (a part of an earlier build): rerun it"
-                )))
-            }
-        }
-    }
+    let setup = setup_of_this_build(&parts, shipped)?;
     // The page describes the default family's campaign drawn by today's stream.
     let other_family = parts
         .first()
@@ -387,6 +360,36 @@ fn merge_main(m: &MergeArgs) -> Result<(), Fail> {
         m.out.as_deref(),
         setup,
     )
+}
+
+/// The setup `parts` were run with (`shipped`'s, with the first part's settings), refused
+/// unless it is this build's monitor: its configuration digest, and its behaviour digest
+/// recomputed on the campaign's first draws (a part without one is of an earlier build).
+fn setup_of_this_build(parts: &[(String, Part)], shipped: Setup) -> Result<Setup, Fail> {
+    let mut setup = shipped;
+    let Some((name, p)) = parts.first() else {
+        return Ok(setup);
+    };
+    setup.pre_roll_s = p.campaign.pre_roll_s;
+    setup.config.thresholds.power_on_settle_s = p.campaign.power_on_settle_s;
+    setup.commissioned = p.campaign.commissioned;
+    let digest = part::config_digest(&setup.config);
+    if p.campaign.config_digest != digest {
+        return Err(Fail::Input(format!(
+            "{name}: configuration digest {} is not this build's monitor's ({digest})",
+            p.campaign.config_digest
+        )));
+    }
+    let digest = monitor_digest(&setup, &p.campaign);
+    match &p.campaign.monitor_digest {
+        Some(recorded) if *recorded == digest => Ok(setup),
+        Some(recorded) => Err(Fail::Input(format!(
+            "{name}: monitor digest {recorded} is not this build's monitor's ({digest})"
+        ))),
+        None => Err(Fail::Input(format!(
+            "{name}: no monitor digest (a part of an earlier build): rerun it"
+        ))),
+    }
 }
 
 /// The report of merged `parts`: printed, and written to `docs/monitor.md` and `out`.

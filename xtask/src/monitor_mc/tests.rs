@@ -1,7 +1,8 @@
 //! A campaign cut into 2 or 3 shards, each run on a different number of threads and merged in
 //! any order, gives the unsharded campaign's report and page byte for byte; merge refuses parts
-//! that do not belong together; the per-form report counts each kind's dormant runs; the
-//! committed certification campaign is of this build's configuration and monitor.
+//! that do not belong together or are not of this build's monitor; the per-form report counts
+//! each kind's dormant runs; the committed certification campaign is of this build's
+//! configuration and monitor.
 
 use super::*;
 
@@ -199,6 +200,32 @@ fn merge_refuses_parts_that_do_not_belong_together() {
         part::merge(&[("a".into(), a)], true).map(|(c, _)| c.runs),
         Ok(4)
     );
+}
+
+#[test]
+fn merge_refuses_a_part_not_of_this_builds_monitor() {
+    let (setup, mut c) = campaign();
+    c.monitor_digest = Some(monitor_digest(&setup, &c));
+    let part = |c: &Campaign| {
+        let outcomes = vec![host_tests::mc::Outcome::quiet(None); RUNS as usize];
+        vec![(
+            "p".to_string(),
+            Part::new(c.clone(), [0, 1], 0..RUNS, 0..0, &outcomes),
+        )]
+    };
+    let refusal = |c: &Campaign| match setup_of_this_build(&part(c), setup) {
+        Ok(_) => String::new(),
+        Err(Fail::Input(e) | Fail::Run(e)) => e,
+    };
+    assert_eq!(refusal(&c), "");
+    let mut altered = c.clone();
+    altered.monitor_digest = Some("0x00000000".into());
+    assert!(refusal(&altered).starts_with("p: monitor digest 0x00000000 is not this build's"));
+    altered.monitor_digest = None;
+    assert!(refusal(&altered).starts_with("p: no monitor digest (a part of an earlier build)"));
+    altered = c.clone();
+    altered.config_digest = "0x00000000".into();
+    assert!(refusal(&altered).starts_with("p: configuration digest 0x00000000 is not this build's"));
 }
 
 #[test]
