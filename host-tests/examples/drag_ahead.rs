@@ -52,7 +52,6 @@ fn main() -> Result<(), String> {
         if form(&d.scene) != "paper" {
             continue;
         }
-        let o = evaluate(&d, &campaign);
         let trace = draw_trace_after(&d, PRE_ROLL_S)?;
         let onset = d.scene.faults[0].at_s;
         let drive_on = trace
@@ -60,7 +59,11 @@ fn main() -> Result<(), String> {
             .iter()
             .find(|r| r.t_s >= onset)
             .is_some_and(|r| r.drive_on);
-        if !o.manifested || !drive_on {
+        if !drive_on {
+            continue;
+        }
+        let o = evaluate(&d, &campaign);
+        if !o.manifested {
             continue;
         }
         n += 1;

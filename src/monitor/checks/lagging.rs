@@ -88,21 +88,20 @@ impl Lagging {
         let along = t.dir.apply(t.accel_torque);
         if t.dir != self.dir || ahead || !(started || starts) {
             // Level with its input: its `J_s·ω̇` is followed as a lag's reference.
-            let level = t.dir == self.dir && !ahead;
-            let (calls, reference) = match self.level_calls {
-                0 => (1, along),
+            let level = (t.dir == self.dir && !ahead).then(|| match self.level_calls {
+                0 => (along, 1),
                 n => (
-                    n.saturating_add(1),
                     follow(self.reference, along, p.reference_shift()),
+                    n.saturating_add(1),
                 ),
-            };
+            });
             *self = Lagging {
                 dir: t.dir,
                 out: t.out,
                 ..Lagging::default()
             };
-            if level {
-                (self.reference, self.level_calls) = (reference, calls);
+            if let Some(run) = level {
+                (self.reference, self.level_calls) = run;
             }
             return false;
         }
@@ -113,8 +112,10 @@ impl Lagging {
         };
         self.out = t.out;
         let counted = SLOW.covered(t.ticks);
-        // A lag from a level run: armed at once, on the run's `J_s·ω̇`.
-        if self.lag_ticks == 0 && u32::from(self.level_calls) > p.persistence_ticks() / SLOW.ticks {
+        // A lag after a level run of the persistence time (its calls × ticks per call: no
+        // division) arms at once, on the run's `J_s·ω̇`.
+        let level_run = u32::from(self.level_calls).saturating_mul(SLOW.ticks);
+        if self.lag_ticks == 0 && level_run > p.persistence_ticks() {
             self.lag_ticks = p.persistence_ticks().saturating_add(1);
         }
         let armed = self.lag_ticks > p.persistence_ticks();
