@@ -70,8 +70,8 @@ pub struct Outcome {
     pub false_flags_with_command: usize,
     /// The twin failed to run this draw (reported, never silently dropped).
     pub error: Option<String>,
-    /// A nominal draw whose plant's input comes apart from its output ([`not_driven`]):
-    /// counted apart from the false alarms, whatever the monitor raised.
+    /// A draw whose plant, run without its fault, has its input come apart from its output
+    /// ([`not_driven`]): counted apart from the false alarms and its kind's rates.
     pub not_driven: bool,
     /// The functional test after the run ([`crate::dormant`]): every dormant fault run and a
     /// share of the nominal runs ([`Campaign::test_every`]), physical form only.
@@ -104,9 +104,14 @@ impl Outcome {
         }
     }
 
-    /// A nominal run the false-alarm rate counts: the twin ran it and its plant was driven.
+    /// A run the rates count: the twin ran it and its plant was driven.
+    pub fn counts(&self) -> bool {
+        self.error.is_none() && !self.not_driven
+    }
+
+    /// A nominal run the false-alarm rate counts.
     pub fn counts_as_nominal(&self) -> bool {
-        self.fault.is_none() && self.error.is_none() && !self.not_driven
+        self.fault.is_none() && self.counts()
     }
 }
 

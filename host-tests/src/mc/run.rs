@@ -115,25 +115,31 @@ pub fn evaluate(d: &Draw, campaign: &Campaign) -> Outcome {
         Err(e) => return fail(e),
     };
     let onset = fault.map_or(f64::INFINITY, |f| f.at_s);
-    // A holding fault manifests only where its run leaves the same run without it.
-    let manifest = match fault {
-        Some(f) if f.kind.is_holding() => {
+    // The same draw without its fault: where a holding fault shows, and whether the plant
+    // itself came apart (counted apart, as a nominal run is).
+    let healthy = match fault {
+        Some(_) => {
             let mut healthy = d.clone();
             healthy.scene.faults.clear();
             match draw_trace_after(&healthy, campaign.pre_roll_s) {
-                Ok(same) => manifest_time_beside(&f, &trace, &same),
+                Ok(same) => Some(same),
                 Err(e) => return fail(e),
             }
         }
+        None => None,
+    };
+    let same = healthy.as_ref().unwrap_or(&trace);
+    let manifest = match fault {
+        Some(f) if f.kind.is_holding() => manifest_time_beside(&f, &trace, same),
         Some(f) => manifest_time(&f, &trace),
         None => None,
     };
     let manifested = manifest.is_some();
-    let not_driven = fault.is_none() && not_driven(&trace, &d.scene.sensors);
+    let not_driven = not_driven(same, &d.scene.sensors);
     let every = campaign.test_every;
     let tested = every > 0
         && match fault {
-            Some(_) => !manifested,
+            Some(_) => !manifested && !not_driven,
             None => !not_driven && d.scene.noise.seed.is_multiple_of(every),
         };
     let test = if tested {

@@ -123,8 +123,18 @@ fn table(s: &mut String, seed: u64, what: &str, unc: &Value, com: &Value) {
     for kind in FAULT_KINDS {
         let k = format!("{kind:?}");
         row(&k, &|v| {
-            let d = &v["dormant"][k.as_str()];
-            format!("{}; {d} dormant", cell(&v["detection"][k.as_str()]))
+            let (d, a) = (
+                &v["dormant"][k.as_str()],
+                &v["not_driven_by_kind"][k.as_str()],
+            );
+            let found = &v["dormant_found"][k.as_str()];
+            let tested = &v["dormant_functional_tested"][k.as_str()];
+            let apart = match a.as_u64() {
+                Some(n) if n > 0 => format!("; {n} plant apart"),
+                _ => String::new(),
+            };
+            let cell = cell(&v["detection"][k.as_str()]);
+            format!("{cell}; {d} dormant, {found} found, {tested} tested{apart}")
         });
     }
     row("with the drive's current command: false alarms", &|v| {
@@ -162,7 +172,7 @@ fn table(s: &mut String, seed: u64, what: &str, unc: &Value, com: &Value) {
         v.get("commissioning_refused")
             .map_or("—".into(), Value::to_string)
     });
-    row("not driven (counted apart)", &|v| {
+    row("nominal runs not driven (counted apart)", &|v| {
         v["not_driven"].to_string()
     });
 }
@@ -204,7 +214,12 @@ pub fn main(a: &FamilyArgs) -> Result<(), String> {
          - Cells: detected within 50 ms / manifested, or false alarms / nominal runs, with the \
          two-sided 95 % Clopper–Pearson interval (false alarms: its upper bound per run); after \
          a kind's rate, its runs in that form whose fault never manifested (*dormant*, \
-         monitor.md, \"How it is measured\"). \
+         monitor.md, \"How it is measured\"), how many of those were found, by the drive's \
+         own cycle (`brake_degraded` in the run) or by the functional test after it, and after \
+         how many that test ran (*tested*: the twin runs it on the physical form only, \
+         functional-test.md, \"Where it cannot run\"); and, where any, those whose plant came apart \
+         without the fault (*plant apart*, counted apart as a nominal run is; model.md, \
+         \"The plant family\"). \
          Accuracy: the nominal reverse_load and forward_load runs where twin and monitor both \
          end locked, against issue 16's targets for a commissioned unit (holding torque within \
          2 %, pressing-force RMS within 10 % of its peak, lock time within 10 ms), compared as \

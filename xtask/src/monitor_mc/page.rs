@@ -121,14 +121,15 @@ pub fn table(r: &Value) -> String {
         r["twin_errors"].as_array().map_or(0, Vec::len),
         r["not_driven_runs"].as_u64().unwrap_or(0)
     );
-    let _ = writeln!(s, "| fault kind | runs | manifested | detected ≤ 50 ms | rate [95 % interval] | median latency (ms) | max latency (ms) | false alarms before onset | onset after settling: detected / manifested | rate there [95 % interval] | with the drive's current command: rate [95 % interval] |");
-    let _ = writeln!(s, "|---|---|---|---|---|---|---|---|---|---|---|");
+    let _ = writeln!(s, "| fault kind | runs | plant apart | manifested | detected ≤ 50 ms | rate [95 % interval] | median latency (ms) | max latency (ms) | false alarms before onset | onset after settling: detected / manifested | rate there [95 % interval] | with the drive's current command: rate [95 % interval] |");
+    let _ = writeln!(s, "|---|---|---|---|---|---|---|---|---|---|---|---|");
     for row in r["fault_kinds"].as_array().into_iter().flatten() {
         let _ = writeln!(
             s,
-            "| {} | {} | {} | {} | {} | {} | {} | {} | {} / {} | {} | {} |",
+            "| {} | {} | {} | {} | {} | {} | {} | {} | {} | {} / {} | {} | {} |",
             row["kind"].as_str().unwrap_or(""),
             row["runs"],
+            row["not_driven"],
             row["manifested"],
             row["detected_within_window"],
             fmt_rate(&row["detection_rate"]),
@@ -355,7 +356,8 @@ pub fn doc(r: &Value, record: Option<&Value>) -> String {
          whose plant's input comes apart from its output (counted apart: `model.md`, \
          \"The plant family\").\n\
          - Fault draws: the same plus one fault, onset uniform over the scene, severity \
-         0.5–1 (each kind's meaning is in `model.md`).\n\
+         0.5–1 (each kind's meaning is in `model.md`); a draw whose plant, run without its \
+         fault, comes apart is counted apart from its kind's rates (*plant apart*).\n\
          - Each run's random draws come from its own stream, the SplitMix hash of (seed, nominal \
          or fault kind, run index) (`host_tests::mc::run_rng`): a campaign cut into shards \
          (`--shard K/N --out part-K.json`, then `monitor-mc merge part-*.json`, or the Slurm \

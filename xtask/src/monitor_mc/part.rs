@@ -10,8 +10,12 @@ use noback::monitor::Config;
 use serde::{Deserialize, Serialize};
 use std::ops::Range;
 
-/// The part files' format tag.
-pub const FORMAT: &str = "noback-monitor-mc-part/1";
+/// The part files' format tag. `/2` counts a fault run whose plant came apart without its
+/// fault (`FaultRun::not_driven`) apart; a `/1` part is read only when it holds no fault run.
+pub const FORMAT: &str = "noback-monitor-mc-part/2";
+
+/// The previous format, identical for nominal runs.
+const FORMAT_NOMINAL_ONLY: &str = "noback-monitor-mc-part/1";
 
 /// What every part of one campaign shares.
 #[derive(Serialize, Deserialize, Clone, Debug, PartialEq)]
@@ -53,6 +57,9 @@ pub struct FaultRun {
     #[serde(default)]
     pub false_flags_with_command: usize,
     pub error: Option<String>,
+    /// The draw's plant, run without its fault, came apart (`mc::not_driven`): counted apart.
+    #[serde(default)]
+    pub not_driven: bool,
     /// The functional test after the run: `rejected`, `pass` or `fail`; absent if not run.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub test: Option<String>,
@@ -197,6 +204,7 @@ impl Part {
                     false_flags: o.false_flags,
                     false_flags_with_command: o.false_flags_with_command,
                     error: o.error.clone(),
+                    not_driven: o.not_driven,
                     test: o.test.map(|v| verdict_tag(v).into()),
                     warned: o.warned,
                     refused: o.refused,
@@ -230,7 +238,7 @@ fn outcome_of(r: &FaultRun) -> Result<Outcome, String> {
         false_flags: r.false_flags,
         false_flags_with_command: r.false_flags_with_command,
         error: r.error.clone(),
-        not_driven: false,
+        not_driven: r.not_driven,
         test: r.test.as_deref().map(verdict_of).transpose()?,
         warned: r.warned,
         refused: r.refused,
@@ -281,8 +289,12 @@ fn tile(
 
 /// Checks one part against the campaign and its own ranges.
 fn check(name: &str, p: &Part, first: &(String, Campaign)) -> Result<(), String> {
-    if p.format != FORMAT {
-        return Err(format!("{name}: format `{}`, not `{FORMAT}`", p.format));
+    let nominal_only = p.format == FORMAT_NOMINAL_ONLY && p.fault_runs.is_empty();
+    if p.format != FORMAT && !nominal_only {
+        return Err(format!(
+            "{name}: format `{}`, not `{FORMAT}` (`{FORMAT_NOMINAL_ONLY}` only without fault runs)",
+            p.format
+        ));
     }
     let c = &p.campaign;
     let f = &first.1;

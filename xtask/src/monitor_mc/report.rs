@@ -47,6 +47,17 @@ pub fn rate(k: usize, n: usize) -> Value {
     })
 }
 
+/// A dormant fault found: by the drive's own cycle (`brake_degraded` in the run) or by the
+/// functional test after it.
+fn is_found(o: &Outcome) -> bool {
+    o.warned || o.test == Some(Verdict::Fail)
+}
+
+/// The functional test ran after the run (the unit was not rejected at acceptance).
+fn is_tested(o: &Outcome) -> bool {
+    matches!(o.test, Some(Verdict::Pass | Verdict::Fail))
+}
+
 fn detected(o: &Outcome) -> bool {
     o.latency_s.is_some_and(|l| l <= DETECTION_WINDOW_S)
 }
@@ -61,7 +72,10 @@ fn detected_with_command(o: &Outcome) -> bool {
 /// in [`FAULT_KINDS`] order, each by run index).
 pub fn build(meta: &Meta, outcomes: &[Outcome]) -> Result<Value, String> {
     let errors: Vec<&str> = outcomes.iter().filter_map(|o| o.error.as_deref()).collect();
-    let not_driven = outcomes.iter().filter(|o| o.not_driven).count();
+    let not_driven = outcomes
+        .iter()
+        .filter(|o| o.fault.is_none() && o.error.is_none() && o.not_driven)
+        .count();
     let nominal: Vec<&Outcome> = outcomes.iter().filter(|o| o.counts_as_nominal()).collect();
     let false_alarm_runs = nominal.iter().filter(|o| o.false_flags > 0).count();
     let false_alarm = rate(false_alarm_runs, nominal.len());
@@ -75,10 +89,8 @@ pub fn build(meta: &Meta, outcomes: &[Outcome]) -> Result<Value, String> {
     let mut rows = Vec::new();
     let mut all_ok = errors.is_empty() && false_alarm_runs == 0;
     for kind in FAULT_KINDS {
-        let runs: Vec<&Outcome> = outcomes
-            .iter()
-            .filter(|o| o.fault == Some(kind) && o.error.is_none())
-            .collect();
+        let of_kind = || outcomes.iter().filter(|o| o.fault == Some(kind));
+        let runs: Vec<&Outcome> = of_kind().filter(|o| o.counts()).collect();
         let manifested: Vec<&Outcome> = runs.iter().copied().filter(|o| o.manifested).collect();
         let mut latencies: Vec<f64> = manifested
             .iter()
@@ -121,16 +133,14 @@ pub fn build(meta: &Meta, outcomes: &[Outcome]) -> Result<Value, String> {
         let tested: Vec<&Outcome> = dormant
             .iter()
             .copied()
-            .filter(|o| o.warned || matches!(o.test, Some(Verdict::Pass | Verdict::Fail)))
+            .filter(|o| o.warned || is_tested(o))
             .collect();
         let warned = dormant.iter().filter(|o| o.warned).count();
-        let found = tested
-            .iter()
-            .filter(|o| o.warned || o.test == Some(Verdict::Fail))
-            .count();
+        let found = tested.iter().filter(|o| is_found(o)).count();
         rows.push(json!({
             "kind": format!("{kind:?}"),
             "runs": runs.len(),
+            "not_driven": of_kind().filter(|o| o.error.is_none() && o.not_driven).count(),
             "dormant": dormant.len(),
             "dormant_tested": tested.len(),
             "dormant_warned": warned,
@@ -249,16 +259,19 @@ pub fn by_form(outcomes: &[Outcome], forms: &[&str], commissioned: bool) -> Valu
             .iter()
             .filter(|o| o.false_flags_with_command > 0)
             .count();
-        let (mut detection, mut detection_with_command, mut dormant) = (
+        let (mut detection, mut detection_with_command) =
+            (serde_json::Map::new(), serde_json::Map::new());
+        let (mut dormant, mut dormant_found, mut dormant_tested, mut apart) = (
+            serde_json::Map::new(),
             serde_json::Map::new(),
             serde_json::Map::new(),
             serde_json::Map::new(),
         );
+        let not_driven = |o: &&&Outcome| o.error.is_none() && o.not_driven;
         for kind in FAULT_KINDS {
-            let (manifested, never): (Vec<&&Outcome>, Vec<&&Outcome>) = mine
-                .iter()
-                .filter(|o| o.fault == Some(kind) && o.error.is_none())
-                .partition(|o| o.manifested);
+            let of_kind = || mine.iter().filter(|o| o.fault == Some(kind));
+            let (manifested, never): (Vec<&&Outcome>, Vec<&&Outcome>) =
+                of_kind().filter(|o| o.counts()).partition(|o| o.manifested);
             let hits = |d: fn(&Outcome) -> bool| manifested.iter().filter(|o| d(o)).count();
             let name = format!("{kind:?}");
             detection.insert(name.clone(), rate(hits(detected), manifested.len()));
@@ -266,16 +279,24 @@ pub fn by_form(outcomes: &[Outcome], forms: &[&str], commissioned: bool) -> Valu
                 name.clone(),
                 rate(hits(detected_with_command), manifested.len()),
             );
-            dormant.insert(name, json!(never.len()));
+            dormant.insert(name.clone(), json!(never.len()));
+            let found_here = never.iter().filter(|o| is_found(o)).count();
+            dormant_found.insert(name.clone(), json!(found_here));
+            let tested_here = never.iter().filter(|o| is_tested(o)).count();
+            dormant_tested.insert(name.clone(), json!(tested_here));
+            apart.insert(name, json!(of_kind().filter(not_driven).count()));
         }
         let mut v = json!({
             "false_alarm": rate(false_alarms, nominal.len()),
             "false_alarm_with_command": rate(false_alarms_with_command, nominal.len()),
             "detection_with_command": detection_with_command,
             "errors": mine.iter().filter(|o| o.error.is_some()).count(),
-            "not_driven": mine.iter().filter(|o| o.not_driven).count(),
+            "not_driven": mine.iter().filter(|o| o.fault.is_none()).filter(not_driven).count(),
             "detection": detection,
             "dormant": dormant,
+            "dormant_found": dormant_found,
+            "dormant_functional_tested": dormant_tested,
+            "not_driven_by_kind": apart,
         });
         if commissioned {
             v["commissioning_refused"] = json!(mine.iter().filter(|o| o.refused).count());

@@ -196,6 +196,30 @@ fn merge_refuses_parts_that_do_not_belong_together() {
         &[("a".into(), a.clone())],
         "a: no part holds the nominal runs 4..7 after it",
     );
+    // A part of the format before fault runs could be counted apart: read without fault runs.
+    let older = |mut p: Part| {
+        p.format = "noback-monitor-mc-part/1".into();
+        p
+    };
+    let nominal_only = |c: &Campaign, runs| {
+        let c = Campaign {
+            fault_runs: 0,
+            ..c.clone()
+        };
+        older(empty(&c, runs, 0..0))
+    };
+    assert!(part::merge(
+        &[
+            ("n".into(), nominal_only(&c, 0..4)),
+            ("o".into(), nominal_only(&c, 4..RUNS)),
+        ],
+        false
+    )
+    .is_ok());
+    refused(
+        &[("a".into(), a.clone()), ("o".into(), older(b.clone()))],
+        "o: format `noback-monitor-mc-part/1`",
+    );
     assert_eq!(
         part::merge(&[("a".into(), a)], true).map(|(c, _)| c.runs),
         Ok(4)
@@ -229,7 +253,7 @@ fn merge_refuses_a_part_not_of_this_builds_monitor() {
 }
 
 #[test]
-fn a_fault_run_that_never_manifests_counts_as_dormant_in_its_form_only() {
+fn a_fault_run_that_never_manifests_counts_as_dormant_in_its_form_only_and_a_plant_apart_in_none() {
     use host_tests::mc::Outcome;
     use noback_twin::fault::FaultKind;
     let kind = Some(FaultKind::PackWear);
@@ -241,18 +265,42 @@ fn a_fault_run_that_never_manifests_counts_as_dormant_in_its_form_only() {
         error: Some("twin".into()),
         ..Outcome::quiet(kind)
     };
+    // Draws whose plant came apart without the fault: neither detected, missed nor dormant.
+    let apart = |manifested| Outcome {
+        manifested,
+        not_driven: true,
+        ..Outcome::quiet(kind)
+    };
+    let found = Outcome {
+        warned: true,
+        ..Outcome::quiet(kind)
+    };
     let outcomes = [
         manifested,
-        Outcome::quiet(kind),
+        found,
         failed,
-        Outcome::quiet(kind),
+        apart(true),
+        apart(false),
+        Outcome {
+            test: Some(host_tests::dormant::Verdict::Pass),
+            ..Outcome::quiet(kind)
+        },
     ];
-    let forms = ["paper", "paper", "paper", "physical"];
+    let forms = ["paper", "paper", "paper", "paper", "paper", "physical"];
     let v = super::report::by_form(&outcomes, &forms, false);
     assert_eq!(v["paper"]["dormant"]["PackWear"], 1);
-    assert_eq!(v["paper"]["detection"]["PackWear"]["of"][1], 1);
+    assert_eq!(
+        v["paper"]["detection"]["PackWear"]["of"],
+        serde_json::json!([0, 1])
+    );
+    assert_eq!(v["paper"]["not_driven_by_kind"]["PackWear"], 2);
+    assert_eq!(v["paper"]["not_driven"], 0, "the nominal runs' count");
     assert_eq!(v["physical"]["dormant"]["PackWear"], 1);
     assert_eq!(v["physical"]["dormant"]["Drag"], 0);
+    // The mark survives a part file.
+    let (_, c) = campaign();
+    let p = Part::new(c, [0, 1], 0..0, 0..1, &outcomes[3..4]);
+    assert!(through_text(&p).fault_runs[0].not_driven);
 }
 
 /// The committed certification campaign was run on the configuration this build ships for its
