@@ -63,7 +63,8 @@ fn main() -> Result<(), String> {
             continue;
         }
         let o = evaluate(&d, &campaign);
-        if !o.manifested {
+        // A plant that comes apart without the drag is counted apart, as on the pages.
+        if !o.manifested || o.not_driven {
             continue;
         }
         n += 1;
