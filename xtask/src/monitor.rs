@@ -75,15 +75,16 @@ fn functional_test_json(
     }))
 }
 
-/// Whether the run's input came apart from its output, and its false alarms where it did not:
-/// such a plant is not healthy (the Monte Carlo counts it apart), so its flags are not false.
+/// Whether the plant's input came apart from its output on `plant` (the run without its faults),
+/// and the run's false alarms where it did not: such a plant is not healthy (the Monte Carlo
+/// counts it apart), so its flags are not false.
 fn counted_alarms(
-    trace: &Trace,
+    plant: &Trace,
     sensors: &SensorConfig,
     faults: &[Fault],
     acc: &Accuracy,
 ) -> (bool, Option<usize>) {
-    let apart = not_driven(trace, sensors);
+    let apart = not_driven(plant, sensors);
     (apart, (!apart).then(|| false_alarms(faults, acc)))
 }
 
@@ -106,7 +107,6 @@ pub fn main(a: &MonitorArgs) -> Result<i32, String> {
     let estimates = run_monitor(&trace, config)?;
     let acc = compare(&trace, &estimates);
     let sensors = scene.as_ref().map_or(config.sensors, |s| s.sensors);
-    let (apart, counted) = counted_alarms(&trace, &sensors, &faults, &acc);
     let functional_test = match scene
         .as_ref()
         .filter(|s| s.kind == SceneKind::FunctionalTest)
@@ -115,15 +115,18 @@ pub fn main(a: &MonitorArgs) -> Result<i32, String> {
         None => None,
     };
 
-    // A holding fault manifests where the scene leaves the same scene without its faults.
+    // The same scene without its faults: where a holding fault manifests, and whether the plant
+    // itself came apart (judged there, as the Monte Carlo judges a fault draw).
     let healthy = match scene.as_ref() {
-        Some(s) if faults.iter().any(|f| f.kind.is_holding()) => {
+        Some(s) if !faults.is_empty() => {
             let mut s = s.clone();
             s.faults.clear();
             Some(scene_trace(&s)?)
         }
         _ => None,
     };
+    let (apart, counted) =
+        counted_alarms(healthy.as_ref().unwrap_or(&trace), &sensors, &faults, &acc);
     let detections: Vec<_> = faults
         .iter()
         .map(|f| {

@@ -55,7 +55,7 @@ impl Campaign {
 }
 
 /// Nominal draws [`behaviour_digest`] runs: the first 128 of the plant family hold every
-/// (form, scene kind, load direction) class at seeds 2718, 3141 and 4242; the first 8, 6–8 of 20.
+/// (form, scene kind, load direction) class at seeds 2718, 3141 and 4242.
 pub const BEHAVIOUR_RUNS: u64 = 128;
 
 /// The monitor's behaviour in a campaign: FNV-1a over every estimate's words, without and

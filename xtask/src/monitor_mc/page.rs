@@ -251,7 +251,9 @@ fn campaign_sizes(r: &Value) -> String {
         ) else {
             continue;
         };
-        let share = row["manifested"].as_f64().unwrap_or(0.0) / row["runs"].as_f64().unwrap_or(1.0);
+        // Plant-apart draws are drawn and run too.
+        let drawn = row["runs"].as_f64().unwrap_or(1.0) + row["not_driven"].as_f64().unwrap_or(0.0);
+        let share = row["manifested"].as_f64().unwrap_or(0.0) / drawn;
         let need = trials_for_width(p, 0.02, 10_000_000);
         let _ = writeln!(
             s,
@@ -357,7 +359,7 @@ pub fn doc(r: &Value, record: Option<&Value>) -> String {
          \"The plant family\").\n\
          - Fault draws: the same plus one fault, onset uniform over the scene, severity \
          0.5–1 (each kind's meaning is in `model.md`); a draw whose plant, run without its \
-         fault, comes apart is counted apart from its kind's rates (*plant apart*).\n\
+         fault, comes apart is counted apart from its kind's rates and *runs* (*plant apart*).\n\
          - Each run's random draws come from its own stream, the SplitMix hash of (seed, nominal \
          or fault kind, run index) (`host_tests::mc::run_rng`): a campaign cut into shards \
          (`--shard K/N --out part-K.json`, then `monitor-mc merge part-*.json`, or the Slurm \

@@ -10,12 +10,8 @@ use noback::monitor::Config;
 use serde::{Deserialize, Serialize};
 use std::ops::Range;
 
-/// The part files' format tag. `/2` counts a fault run whose plant came apart without its
-/// fault (`FaultRun::not_driven`) apart; a `/1` part is read only when it holds no fault run.
+/// The part files' format tag (`/2`: a fault run records `not_driven`).
 pub const FORMAT: &str = "noback-monitor-mc-part/2";
-
-/// The previous format, identical for nominal runs.
-const FORMAT_NOMINAL_ONLY: &str = "noback-monitor-mc-part/1";
 
 /// What every part of one campaign shares.
 #[derive(Serialize, Deserialize, Clone, Debug, PartialEq)]
@@ -289,12 +285,8 @@ fn tile(
 
 /// Checks one part against the campaign and its own ranges.
 fn check(name: &str, p: &Part, first: &(String, Campaign)) -> Result<(), String> {
-    let nominal_only = p.format == FORMAT_NOMINAL_ONLY && p.fault_runs.is_empty();
-    if p.format != FORMAT && !nominal_only {
-        return Err(format!(
-            "{name}: format `{}`, not `{FORMAT}` (`{FORMAT_NOMINAL_ONLY}` only without fault runs)",
-            p.format
-        ));
+    if p.format != FORMAT {
+        return Err(format!("{name}: format `{}`, not `{FORMAT}`", p.format));
     }
     let c = &p.campaign;
     let f = &first.1;

@@ -196,30 +196,6 @@ fn merge_refuses_parts_that_do_not_belong_together() {
         &[("a".into(), a.clone())],
         "a: no part holds the nominal runs 4..7 after it",
     );
-    // A part of the format before fault runs could be counted apart: read without fault runs.
-    let older = |mut p: Part| {
-        p.format = "noback-monitor-mc-part/1".into();
-        p
-    };
-    let nominal_only = |c: &Campaign, runs| {
-        let c = Campaign {
-            fault_runs: 0,
-            ..c.clone()
-        };
-        older(empty(&c, runs, 0..0))
-    };
-    assert!(part::merge(
-        &[
-            ("n".into(), nominal_only(&c, 0..4)),
-            ("o".into(), nominal_only(&c, 4..RUNS)),
-        ],
-        false
-    )
-    .is_ok());
-    refused(
-        &[("a".into(), a.clone()), ("o".into(), older(b.clone()))],
-        "o: format `noback-monitor-mc-part/1`",
-    );
     assert_eq!(
         part::merge(&[("a".into(), a)], true).map(|(c, _)| c.runs),
         Ok(4)
@@ -297,10 +273,31 @@ fn a_fault_run_that_never_manifests_counts_as_dormant_in_its_form_only_and_a_pla
     assert_eq!(v["paper"]["not_driven"], 0, "the nominal runs' count");
     assert_eq!(v["physical"]["dormant"]["PackWear"], 1);
     assert_eq!(v["physical"]["dormant"]["Drag"], 0);
-    // The mark survives a part file.
+    // Found: by the run's own `brake_degraded` or the test; tested: the test ran.
+    assert_eq!(v["paper"]["dormant_found"]["PackWear"], 1);
+    assert_eq!(v["paper"]["dormant_functional_tested"]["PackWear"], 0);
+    assert_eq!(v["physical"]["dormant_found"]["PackWear"], 0);
+    assert_eq!(v["physical"]["dormant_functional_tested"]["PackWear"], 1);
+}
+
+#[test]
+fn a_fault_run_on_a_plant_apart_stays_apart_through_a_merge() {
+    use host_tests::mc::Outcome;
     let (_, c) = campaign();
-    let p = Part::new(c, [0, 1], 0..0, 0..1, &outcomes[3..4]);
-    assert!(through_text(&p).fault_runs[0].not_driven);
+    let c = Campaign {
+        runs: 0,
+        fault_runs: 1,
+        ..c
+    };
+    let apart = |k| k == FAULT_KINDS[2];
+    let outcomes = FAULT_KINDS.map(|k| Outcome {
+        not_driven: apart(k),
+        ..Outcome::quiet(Some(k))
+    });
+    let p = through_text(&Part::new(c, [0, 1], 0..0, 0..1, &outcomes));
+    let (_, merged) = part::merge(&[("p".into(), p)], false).expect("merge");
+    let marked: Vec<_> = merged.iter().map(|o| o.not_driven).collect();
+    assert_eq!(marked, FAULT_KINDS.map(apart).to_vec());
 }
 
 /// The committed certification campaign was run on the configuration this build ships for its
