@@ -27,7 +27,10 @@ fn a_fault_draw_whose_plant_comes_apart_without_the_fault_is_counted_apart() {
 /// (5555's draw 8) part the encoders themselves: that is the fault showing, and it counts.
 #[test]
 fn a_fault_that_parts_the_encoders_itself_counts_in_its_kinds_rates() {
-    for (seed, run, kind) in [(1616, 22, FaultKind::EncoderStuck), (5555, 8, FaultKind::Drag)] {
+    for (seed, run, kind) in [
+        (1616, 22, FaultKind::EncoderStuck),
+        (5555, 8, FaultKind::Drag),
+    ] {
         let (o, own) = judged(seed, run, kind);
         assert!(own, "{seed} {run}: the faulted trace comes apart");
         assert!(!o.not_driven && o.counts(), "{seed} {run}: {o:?}");
