@@ -113,6 +113,17 @@ impl Outcome {
     pub fn counts_as_nominal(&self) -> bool {
         self.fault.is_none() && self.counts()
     }
+
+    /// The fault was flagged within [`DETECTION_WINDOW_S`] of manifesting.
+    pub fn detected(&self) -> bool {
+        self.latency_s.is_some_and(|l| l <= DETECTION_WINDOW_S)
+    }
+
+    /// [`Outcome::detected`] with the drive's current command in the monitor's inputs.
+    pub fn detected_with_command(&self) -> bool {
+        self.latency_with_command_s
+            .is_some_and(|l| l <= DETECTION_WINDOW_S)
+    }
 }
 
 /// Input travel (rad, output side) against a still output beyond which a draw's plant has come

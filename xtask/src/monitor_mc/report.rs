@@ -6,7 +6,7 @@
 use crate::replay::twin_trace;
 use host_tests::accuracy::{compare, run_monitor};
 use host_tests::dormant::Verdict;
-use host_tests::mc::{Context, Outcome, DETECTION_WINDOW_S, FAULT_KINDS};
+use host_tests::mc::{Context, Outcome, FAULT_KINDS};
 use host_tests::stats::clopper_pearson;
 use noback::monitor::Config;
 use serde_json::{json, Value};
@@ -58,16 +58,6 @@ fn is_tested(o: &Outcome) -> bool {
     matches!(o.test, Some(Verdict::Pass | Verdict::Fail))
 }
 
-fn detected(o: &Outcome) -> bool {
-    o.latency_s.is_some_and(|l| l <= DETECTION_WINDOW_S)
-}
-
-/// [`detected`] with the drive's current command in the monitor's inputs.
-fn detected_with_command(o: &Outcome) -> bool {
-    o.latency_with_command_s
-        .is_some_and(|l| l <= DETECTION_WINDOW_S)
-}
-
 /// The report of a campaign whose outcomes are `outcomes` (nominal first, then each fault kind
 /// in [`FAULT_KINDS`] order, each by run index).
 pub fn build(meta: &Meta, outcomes: &[Outcome]) -> Result<Value, String> {
@@ -94,14 +84,14 @@ pub fn build(meta: &Meta, outcomes: &[Outcome]) -> Result<Value, String> {
         let manifested: Vec<&Outcome> = runs.iter().copied().filter(|o| o.manifested).collect();
         let mut latencies: Vec<f64> = manifested
             .iter()
-            .filter(|o| detected(o))
+            .filter(|o| o.detected())
             .filter_map(|o| o.latency_s)
             .collect();
         latencies.sort_by(f64::total_cmp);
         let hits = latencies.len();
         let hits_with_command = manifested
             .iter()
-            .filter(|o| detected_with_command(o))
+            .filter(|o| o.detected_with_command())
             .count();
         // No manifested run leaves the target unproven: it counts as not met, shown as "—".
         let detection = rate(hits, manifested.len());
@@ -114,7 +104,7 @@ pub fn build(meta: &Meta, outcomes: &[Outcome]) -> Result<Value, String> {
             .copied()
             .filter(|o| o.context != Some(Context::Settling))
             .collect();
-        let hits_settled = settled.iter().filter(|o| detected(o)).count();
+        let hits_settled = settled.iter().filter(|o| o.detected()).count();
         let by_context: Vec<_> = Context::ALL
             .iter()
             .map(|c| {
@@ -122,7 +112,7 @@ pub fn build(meta: &Meta, outcomes: &[Outcome]) -> Result<Value, String> {
                 json!({
                     "context": context_name(*c),
                     "manifested": here.clone().count(),
-                    "missed": here.filter(|o| !detected(o)).count(),
+                    "missed": here.filter(|o| !o.detected()).count(),
                 })
             })
             .collect();
@@ -274,10 +264,13 @@ pub fn by_form(outcomes: &[Outcome], forms: &[&str], commissioned: bool) -> Valu
                 of_kind().filter(|o| o.counts()).partition(|o| o.manifested);
             let hits = |d: fn(&Outcome) -> bool| manifested.iter().filter(|o| d(o)).count();
             let name = format!("{kind:?}");
-            detection.insert(name.clone(), rate(hits(detected), manifested.len()));
+            detection.insert(
+                name.clone(),
+                rate(hits(Outcome::detected), manifested.len()),
+            );
             detection_with_command.insert(
                 name.clone(),
-                rate(hits(detected_with_command), manifested.len()),
+                rate(hits(Outcome::detected_with_command), manifested.len()),
             );
             dormant.insert(name.clone(), json!(never.len()));
             let found_here = never.iter().filter(|o| is_found(o)).count();
