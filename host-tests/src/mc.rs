@@ -109,6 +109,11 @@ impl Outcome {
         self.error.is_none() && !self.not_driven
     }
 
+    /// A run the twin ran whose plant came apart: counted apart from the rates.
+    pub fn counted_apart(&self) -> bool {
+        self.error.is_none() && self.not_driven
+    }
+
     /// A nominal run the false-alarm rate counts.
     pub fn counts_as_nominal(&self) -> bool {
         self.fault.is_none() && self.counts()

@@ -174,7 +174,7 @@ impl Part {
             false_alarm_runs_with_command: nominal_where(|o| {
                 o.counts_as_nominal() && o.false_flags_with_command > 0
             }),
-            not_driven_runs: nominal_where(|o| o.error.is_none() && o.not_driven),
+            not_driven_runs: nominal_where(Outcome::counted_apart),
             refused_runs: nominal_where(|o| o.refused),
             nominal_errors: nominal
                 .clone()

@@ -64,7 +64,7 @@ pub fn build(meta: &Meta, outcomes: &[Outcome]) -> Result<Value, String> {
     let errors: Vec<&str> = outcomes.iter().filter_map(|o| o.error.as_deref()).collect();
     let not_driven = outcomes
         .iter()
-        .filter(|o| o.fault.is_none() && o.error.is_none() && o.not_driven)
+        .filter(|o| o.fault.is_none() && o.counted_apart())
         .count();
     let nominal: Vec<&Outcome> = outcomes.iter().filter(|o| o.counts_as_nominal()).collect();
     let false_alarm_runs = nominal.iter().filter(|o| o.false_flags > 0).count();
@@ -130,7 +130,7 @@ pub fn build(meta: &Meta, outcomes: &[Outcome]) -> Result<Value, String> {
         rows.push(json!({
             "kind": format!("{kind:?}"),
             "runs": runs.len(),
-            "not_driven": of_kind().filter(|o| o.error.is_none() && o.not_driven).count(),
+            "not_driven": of_kind().filter(|o| o.counted_apart()).count(),
             "dormant": dormant.len(),
             "dormant_tested": tested.len(),
             "dormant_warned": warned,
@@ -257,7 +257,6 @@ pub fn by_form(outcomes: &[Outcome], forms: &[&str], commissioned: bool) -> Valu
             serde_json::Map::new(),
             serde_json::Map::new(),
         );
-        let not_driven = |o: &&&Outcome| o.error.is_none() && o.not_driven;
         for kind in FAULT_KINDS {
             let of_kind = || mine.iter().filter(|o| o.fault == Some(kind));
             let (manifested, never): (Vec<&&Outcome>, Vec<&&Outcome>) =
@@ -277,14 +276,14 @@ pub fn by_form(outcomes: &[Outcome], forms: &[&str], commissioned: bool) -> Valu
             dormant_found.insert(name.clone(), json!(found_here));
             let tested_here = never.iter().filter(|o| is_tested(o)).count();
             dormant_tested.insert(name.clone(), json!(tested_here));
-            apart.insert(name, json!(of_kind().filter(not_driven).count()));
+            apart.insert(name, json!(of_kind().filter(|o| o.counted_apart()).count()));
         }
         let mut v = json!({
             "false_alarm": rate(false_alarms, nominal.len()),
             "false_alarm_with_command": rate(false_alarms_with_command, nominal.len()),
             "detection_with_command": detection_with_command,
             "errors": mine.iter().filter(|o| o.error.is_some()).count(),
-            "not_driven": mine.iter().filter(|o| o.fault.is_none()).filter(not_driven).count(),
+            "not_driven": mine.iter().filter(|o| o.fault.is_none() && o.counted_apart()).count(),
             "detection": detection,
             "dormant": dormant,
             "dormant_found": dormant_found,
