@@ -80,11 +80,8 @@ pub enum Verdict {
 }
 
 /// The functional test of draw `d`'s unit, commissioned on its healthy acceptance test, with
-/// the run's faults in place; `None` for the paper form.
+/// the run's faults in place.
 pub fn functional_test_after(d: &Draw, config: Config) -> Result<Option<Verdict>, String> {
-    if d.scene.reading != Reading::Physical {
-        return Ok(None);
-    }
     let procedure = TestConfig::DEFAULT;
     let start = noback_twin::scene::DEFAULT_TEST.start_s;
     let mut rng = Rng::new(d.scene.noise.seed ^ 0x7e57);

@@ -74,7 +74,7 @@ pub struct Outcome {
     /// ([`not_driven`]): counted apart from the false alarms and its kind's rates.
     pub not_driven: bool,
     /// The functional test after the run ([`crate::dormant`]): every dormant fault run and a
-    /// share of the nominal runs ([`Campaign::test_every`]), physical form only.
+    /// share of the nominal runs ([`Campaign::test_every`]).
     pub test: Option<Verdict>,
     /// `brake_degraded` rose after the fault's onset: the drive's own cycle found the fault.
     pub warned: bool,

@@ -149,14 +149,40 @@ fn settings_that_cannot_test_are_refused() {
     }
 }
 
+/// The test on the paper reading (its push: docs/model.md, "The `paper` reading"), at
+/// `load_scale` times the procedure's load.
+fn paper_report(
+    fault: Option<(FaultKind, f64)>,
+    test: &TestConfig,
+    load_scale: f64,
+) -> noback::monitor::functional_test::TestReport {
+    let mut s = test_scene(fault, load_scale);
+    s.reading = Reading::Paper;
+    let trace = scene_trace(&s).unwrap();
+    run_functional_test(&trace, Config::default(), test, s.test.start_s).unwrap()
+}
+
+/// On the paper form the opening drags the spring-clamped pack at its full capacity (the
+/// physical form a quarter of it), so the two readings weigh load and spring otherwise; the
+/// unit's own acceptance test still separates a healthy unit from a dormant fault.
 #[test]
-fn the_paper_reading_refuses_the_functional_test() {
-    let e = Scene::from_toml(
-        "t",
-        "[scene]\nkind = \"functional_test\"\nreading = \"paper\"\n",
-    )
-    .unwrap_err();
-    assert_eq!(e.key, "scene.reading");
+fn the_paper_reading_runs_the_test_healthy_passes_and_dormant_faults_fail() {
+    let healthy = paper_report(None, &TestConfig::DEFAULT, 1.0);
+    assert_eq!(healthy.result, TestResult::Pass, "{healthy:?}");
+    let jam = paper_report(Some((FaultKind::RampJam, 0.5)), &TestConfig::DEFAULT, 1.0);
+    assert_eq!(jam.result, TestResult::Fail, "{jam:?}");
+    let unit = TestConfig::DEFAULT.commissioned(
+        healthy.breakaway_torque_nm.to_num(),
+        healthy.opening_torque_nm.to_num(),
+    );
+    for scale in [0.95, 1.05] {
+        let r = paper_report(None, &unit, scale);
+        assert_eq!(r.result, TestResult::Pass, "load × {scale}: {r:?}");
+    }
+    for fault in [(FaultKind::SpringBroken, 0.5), (FaultKind::PackWear, 0.7)] {
+        let r = paper_report(Some(fault), &unit, 1.0);
+        assert_eq!(r.result, TestResult::Fail, "{fault:?}: {r:?}");
+    }
 }
 
 /// The one healthy unit of seed 6174's campaign whose test an alarm aborted (docs/decisions.md,

@@ -105,15 +105,8 @@ pub fn load_scene(target: &str, reading: Option<Reading>) -> Result<Scene, Strin
     if let Some(r) = reading {
         scene.reading = r;
     }
-    if scene.kind == SceneKind::FunctionalTest && scene.reading == Reading::Paper {
-        return Err(PAPER_NO_TEST.into());
-    }
     Ok(scene)
 }
-
-/// Why the paper reading runs no functional test.
-pub const PAPER_NO_TEST: &str = "the functional test needs the physical reading: the paper \
-     reading's drive along the load is an ideal speed reference that takes no torque";
 
 /// `twin SCENE|FILE [--reading paper|physical] [--out DIR] [--json]` from raw arguments.
 pub fn twin_main(args: &[String]) -> i32 {

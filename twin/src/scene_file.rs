@@ -214,9 +214,6 @@ impl RawFile {
                 )
             })?,
         };
-        if kind == SceneKind::FunctionalTest && reading == Reading::Paper {
-            return Err(bad("scene.reading", crate::cli::PAPER_NO_TEST.into()));
-        }
         let mut s = Scene::builtin(kind, reading);
         s.name = name.to_string();
         ranged(

@@ -170,7 +170,9 @@ pub fn run_model_with<M: TwinModel>(
         if scene.kind == SceneKind::FunctionalTest && t >= scene.test.start_s + scene.test.open_s {
             let angle = samples.last().map_or(0.0, |s| s.output_angle_rad);
             let rest = *rest_angle.get_or_insert(angle);
-            aborted |= (angle - rest).abs() >= scene.test.abort_angle_rad;
+            // Along the load only: the settle's own travel runs against it.
+            let along = (angle - rest) * scene.load_torque_nm.signum();
+            aborted |= along >= scene.test.abort_angle_rad;
         }
         model.set_drive(scene_drive(scene, t, !aborted), &mut y);
         model.set_faults(PhysicsFaults::at(&scene.faults, t), &mut y);

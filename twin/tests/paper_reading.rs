@@ -194,3 +194,34 @@ fn backlash_option_moves_the_reverse_case_only() {
         run(SceneKind::ForwardLoad).braking_angle_rad
     );
 }
+
+/// The functional test's push on the paper reading (docs/model.md, "The `paper` reading"): the
+/// pack holds the load and the push together while the push relieves the load face, and breaks
+/// away where the quasi-static closed form `C(L) − g·T = L + T` says.
+#[test]
+fn the_test_push_breaks_the_pack_away_at_the_closed_form_torque() {
+    let s = Scene::builtin(SceneKind::FunctionalTest, Reading::Paper);
+    let r = sim::run(&s).unwrap();
+    let (m, l) = (&s.mechanism, s.load_torque_nm);
+    let spring = noback_twin::spring::spring_force_n(m, m.pack_clearance_m, 1.0);
+    let pressing = |t: f64| spring + (l - t) * m.ramp_factor_per_m();
+    let cap = |t: f64| noback_twin::pack::capacity(m, pressing(t), 1.0, true).static_nm;
+    let g = (cap(0.0) - cap(l)) / l;
+    let t_b = (cap(0.0) - l) / (1.0 + g);
+    let pushing = r.samples.iter().filter(|x| x.t_s >= s.test.push_s());
+    let mut held = 0;
+    for x in pushing.clone().take_while(|x| x.brake_state == 2) {
+        let t = x.drive_torque_nm;
+        assert!((x.braking_torque_nm - (l + t)).abs() < 1e-6, "{x:?}");
+        assert!((x.pressing_force_n - pressing(t)).abs() < 1e-6, "{x:?}");
+        held += 1;
+    }
+    assert!(held > 1000, "held {held} samples");
+    let slip = pushing.clone().find(|x| x.brake_state != 2).unwrap();
+    // The torque limit rises 0.02 N·m per millisecond step.
+    assert!(
+        (slip.drive_torque_nm - t_b).abs() <= 0.03,
+        "{slip:?} against {t_b}"
+    );
+    assert!((10.0..12.0).contains(&t_b), "{t_b}");
+}

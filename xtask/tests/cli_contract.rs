@@ -108,10 +108,6 @@ fn bad_values_are_refused_naming_them() {
         (&["qemu", "x.elf", "--icount", "11"], "11"),
         (&["twin", "hold", "--tolerance", "NaN"], "NaN"),
         (&["twin", "hold", "--reading", "exact"], "exact"),
-        (
-            &["twin", "functional_test", "--reading", "paper"],
-            "physical reading",
-        ),
         (&["monitor-mc", "--test-every", "-1"], "-1"),
         (&["twin-bench", "--tolerance", "inf"], "inf"),
         (&["paper", "--tolerance", "-1"], "-1"),

@@ -12,6 +12,10 @@
 //!   its input ramp keeps the pack unlocked (spring drag only); driving along the load
 //!   (closing) the drive only sets the reference the output is compared with (the output may
 //!   lag it by far more than the clearance, as the paper's cycle requires).
+//! - A drive along the load under a torque limit (the functional test's push, [`Drive`]'s
+//!   `torque_limit_nm`) is not a speed reference: it pushes the input with its limit `T`, the
+//!   input turns with the output, and the input ramp relieves the load face by `T` (pressing
+//!   `F_s + (|M| − T)·tanθ/r`) while the pack holds `M + T` (docs/model.md, "The `paper` reading").
 //! - An output that meets the engagement point at the input's speed with the drive on along
 //!   the load *tracks* the input (a Filippov sliding mode of the switch): it runs at the
 //!   reference speed with the pack holding exactly the load. Without this the switch chatters
@@ -56,6 +60,15 @@ pub struct Paper {
     tracking: bool,
 }
 
+impl Drive {
+    /// Torque of a push along the load under a torque limit (N·m, ≥ 0); `None` when the drive is
+    /// off, runs against the load or holds a speed reference.
+    fn limited_push_nm(&self, load_sign: f64) -> Option<f64> {
+        let along = self.on && self.speed_ref_rad_s * load_sign > 0.0;
+        self.torque_limit_nm.filter(|_| along).map(|l| l.max(0.0))
+    }
+}
+
 struct Eval {
     dy: [f64; N],
     /// Pressing force the pack torque corresponds to (N): the full quasi-static force while
@@ -65,6 +78,8 @@ struct Eval {
     /// Fraction of the load's ramp force the load face carries (1 engaged, 0 not, between
     /// while tracking).
     engaged: f64,
+    /// Torque the load face carries (N·m): the load less a limited push.
+    face_nm: f64,
     /// Pressing force the capacities are computed from (N): spring, drag and, while engaged or
     /// tracking, the whole ramp force.
     capacity_pressing_n: f64,
@@ -118,19 +133,27 @@ impl Paper {
         self.mode
     }
 
+    /// The limited push's torque (N·m, ≥ 0), if the drive is pushing along the load.
+    fn push_nm(&self) -> Option<f64> {
+        self.drive.limited_push_nm(self.load_sign())
+    }
+
     fn eval(&self, y: &[f64]) -> Eval {
         let m = &self.cfg.mechanism;
-        let load = self.cfg.load_torque_nm;
+        let push = self.push_nm();
+        // The push adds to what the pack holds and takes its share off the load face.
+        let load = self.cfg.load_torque_nm + push.unwrap_or(0.0) * self.load_sign();
+        let face_nm = (self.cfg.load_torque_nm.abs() - push.unwrap_or(0.0)).max(0.0);
         let w = at(y, THETA_S + 1);
         let delta = (at(y, THETA_S) - at(y, THETA_IN)) * self.load_sign();
-        let engaged = !self.driven && (self.tracking || delta >= 0.0);
+        let engaged = !self.driven && (self.tracking || push.is_some() || delta >= 0.0);
         let spring = spring_force_n(
             m,
             m.pack_clearance_m + self.faults.extra_pack_clearance_m,
             self.faults.spring_scale,
         );
         let ramp = if engaged {
-            load.abs() * m.ramp_factor_per_m() * (1.0 - self.faults.ramp_jam)
+            face_nm * m.ramp_factor_per_m() * (1.0 - self.faults.ramp_jam)
         } else {
             0.0
         };
@@ -163,7 +186,8 @@ impl Paper {
             };
             (pack, -(required_nm + pack))
         } else {
-            (friction::torque_nm(self.mode, required_nm, cap), 0.0)
+            let drive = push.map_or(0.0, |t| t * self.load_sign());
+            (friction::torque_nm(self.mode, required_nm, cap), drive)
         };
         // While tracking the switch is visited in a Filippov mean: report the pressing force
         // (and the load-face share) that gives exactly the pack torque being applied.
@@ -190,7 +214,9 @@ impl Paper {
         } else {
             (required_nm + pack_torque_nm) / m.output_inertia_kg_m2
         };
-        dy[THETA_IN] = if self.drive.on {
+        dy[THETA_IN] = if push.is_some() {
+            w
+        } else if self.drive.on {
             self.drive.speed_ref_rad_s
         } else if self.pushing {
             w
@@ -201,6 +227,7 @@ impl Paper {
             dy,
             pressing_n,
             engaged: engaged_share,
+            face_nm,
             capacity_pressing_n,
             pack_torque_nm,
             required_nm,
@@ -230,7 +257,7 @@ impl Paper {
 
     /// Enter or leave the tracking sliding mode (see the module doc).
     fn update_tracking(&mut self, y: &mut [f64]) {
-        let along = self.drive.on && !self.driven;
+        let along = self.drive.on && !self.driven && self.push_nm().is_none();
         if !along {
             self.tracking = false;
             return;
@@ -358,8 +385,8 @@ impl TwinModel for Paper {
     fn sample(&self, t: f64, y: &[f64]) -> Sample {
         let e = self.eval(y);
         let m = &self.cfg.mechanism;
-        let per_ball = e.engaged * self.cfg.load_torque_nm.abs()
-            / (3.0 * m.socket_radius_m * m.socket_chamfer_rad.cos());
+        let per_ball =
+            e.engaged * e.face_nm / (3.0 * m.socket_radius_m * m.socket_chamfer_rad.cos());
         // Quasi-static axial positions (docs/model.md, "The `paper` reading"): the big shaft
         // sits on the pack, deflected by the pressing force through the pack's Herbert–McWhannell
         // contact (`x = g_p2 + (F_p/k)^(2/3)`); the output balls sit on the output shaft's face,

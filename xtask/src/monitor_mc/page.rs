@@ -93,12 +93,17 @@ fn form_lines(r: &Value) -> String {
     let Some(forms) = r["by_form"].as_object() else {
         return String::new();
     };
-    let mut s = String::from("\n| plant form | nominal runs | with a false alarm | rate [95 % interval] | input apart from output (apart) |\n|---|---|---|---|---|\n");
+    let mut s = String::from("\n| plant form | nominal runs | with a false alarm | rate [95 % interval] | input apart from output (apart) | functional tests after a run: failed / tested, rejected at acceptance |\n|---|---|---|---|---|---|\n");
     for (form, v) in forms {
         let fa = &v["false_alarm"];
+        let ft = &v["functional_tests_nominal"];
+        let tests = match ft["tested"].as_u64() {
+            Some(n) => format!("{} / {n}, {}", ft["failed"], ft["rejected_at_acceptance"]),
+            None => "—".into(),
+        };
         let _ = writeln!(
             s,
-            "| {form} | {} | {} | {} [{}, {}] | {} |",
+            "| {form} | {} | {} | {} [{}, {}] | {} | {tests} |",
             fa["of"][1],
             fa["of"][0],
             sci(&fa["rate"]),
@@ -178,8 +183,8 @@ pub fn table(r: &Value) -> String {
         s,
         "\nDormant faults (runs whose fault never manifested, as defined above), found by the \
          drive's own cycle (`brake_degraded` in the run: the pack let an overrunning load \
-         through) or by the functional test after the run (physical form; \
-         docs/functional-test.md). Nominal runs tested: {}, failed {} {}, healthy units \
+         through) or by the functional test after the run \
+         (docs/functional-test.md). Nominal runs tested: {}, failed {} {}, healthy units \
          rejected at acceptance {}.\n",
         ft["tested"],
         ft["failed"],

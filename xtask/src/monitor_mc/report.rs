@@ -289,6 +289,7 @@ pub fn by_form(outcomes: &[Outcome], forms: &[&str], commissioned: bool) -> Valu
             "dormant_found": dormant_found,
             "dormant_functional_tested": dormant_tested,
             "not_driven_by_kind": apart,
+            "functional_tests_nominal": functional_tests(&nominal.iter().map(|o| **o).collect::<Vec<_>>()),
         });
         if commissioned {
             v["commissioning_refused"] = json!(mine.iter().filter(|o| o.refused).count());

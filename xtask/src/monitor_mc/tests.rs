@@ -281,6 +281,31 @@ fn a_fault_run_that_never_manifests_counts_as_dormant_in_its_form_only_and_a_pla
 }
 
 #[test]
+fn healthy_units_the_functional_test_failed_are_counted_per_form() {
+    use host_tests::dormant::Verdict;
+    use host_tests::mc::Outcome;
+    let nominal = |test| Outcome {
+        test,
+        ..Outcome::quiet(None)
+    };
+    let outcomes = [
+        nominal(Some(Verdict::Fail)),
+        nominal(Some(Verdict::Pass)),
+        nominal(Some(Verdict::Rejected)),
+        nominal(None),
+        nominal(Some(Verdict::Pass)),
+    ];
+    let forms = ["paper", "paper", "paper", "paper", "physical"];
+    let v = super::report::by_form(&outcomes, &forms, false);
+    let paper = &v["paper"]["functional_tests_nominal"];
+    assert_eq!(paper["tested"], 2);
+    assert_eq!(paper["failed"], 1);
+    assert_eq!(paper["rejected_at_acceptance"], 1);
+    assert_eq!(v["physical"]["functional_tests_nominal"]["failed"], 0);
+    assert_eq!(v["physical"]["functional_tests_nominal"]["tested"], 1);
+}
+
+#[test]
 fn a_fault_run_on_a_plant_apart_stays_apart_through_a_merge() {
     use host_tests::mc::Outcome;
     let (_, c) = campaign();
