@@ -1,14 +1,14 @@
 //! The commanded functional test on the plant family (issue 17): each draw of `monitor-mc
-//! --family plant` in one form (default physical) becomes a
-//! `functional_test` scene at its drawn load, run healthy and with a dormant fault of severity
-//! 0.5…1 (spring_broken, ramp_jam, pack_wear, and current_open: a current sensor's gain lost). Uncommissioned the test expects the
+//! --family plant` in one form (default physical) becomes a `functional_test` scene at its
+//! drawn load, run healthy and with a dormant fault of severity 0.5…1 (spring_broken, ramp_jam,
+//! pack_wear, and current_open: a current sensor's gain lost). Uncommissioned the test expects the
 //! design's breakaway ([`TestConfig::DEFAULT`]); commissioned, the unit's own breakaway and
 //! opening torque at its acceptance test ([`TestConfig::commissioned`]), and for comparison its
 //! breakaway alone. The tests in service run at a load within ±5 % of the procedure's and with
 //! fresh sensor noise. Prints pass/fail counts.
 //!
-//! `cargo run --release -p host-tests --example functional_test_family -- [RUNS] [SEED]`
-//! (defaults 200, 4242).
+//! `cargo run --release -p host-tests --example functional_test_family -- [RUNS] [SEED]
+//! [paper|physical]` (defaults 200, 4242, physical).
 
 use host_tests::accuracy::{run_functional_test, scene_trace};
 use host_tests::dormant;

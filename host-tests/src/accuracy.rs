@@ -327,7 +327,7 @@ pub const FAILED_HOLD_SLIP_S: f64 = 0.020;
 
 /// The current (A) below which a lost gain cannot be seen: twice the current sensor's offset
 /// tolerance of the plant family (±0.25 A), ten times its noise (≤ 0.1 A σ, averaged). The paper
-/// reading closes on less than 0.25 A (its drive along the load takes no torque).
+/// reading closes on less than 0.25 A (its speed-reference drive along the load takes no torque).
 pub const VISIBLE_CURRENT_A: f64 = 0.5;
 
 /// How far the output must turn for a failure to hold, or a frozen output reading, to show

@@ -2,15 +2,13 @@
 //! unit's acceptance, and the test at the end of a Monte Carlo run that finds dormant faults
 //! (docs/monitor.md). There the unit is commissioned by its healthy acceptance test at the
 //! procedure's load; in service the test runs with the run's faults in place, at a load within
-//! ±5 % of the procedure's and with fresh sensor noise. Only the physical form can run it (the
-//! paper reading's drive along the load takes no torque).
+//! ±5 % of the procedure's and with fresh sensor noise, on the draw's own reading.
 
 use crate::accuracy::{run_functional_test, scene_trace};
 use crate::mc::Draw;
 use noback::monitor::functional_test::{TestConfig, TestResult};
 use noback::monitor::Config;
 use noback_twin::fault::{Fault, FaultKind};
-use noback_twin::reading::Reading;
 use noback_twin::scene::{Scene, SceneKind};
 use noback_twin::sensing::Rng;
 use noback_twin::trace::Trace;
@@ -21,7 +19,7 @@ pub const LOAD_TOLERANCE: f64 = 0.05;
 /// A `functional_test` scene of `base`'s plant (mechanism, sensors, noise, open items) at
 /// `load_nm`, with `faults` in place from the start.
 pub fn test_scene(base: &Scene, load_nm: f64, faults: &[Fault]) -> Scene {
-    let mut s = Scene::builtin(SceneKind::FunctionalTest, Reading::Physical);
+    let mut s = Scene::builtin(SceneKind::FunctionalTest, base.reading);
     s.name = format!("{}-test", base.name);
     s.load_torque_nm = load_nm;
     s.mechanism = base.mechanism;

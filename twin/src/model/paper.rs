@@ -12,10 +12,9 @@
 //!   its input ramp keeps the pack unlocked (spring drag only); driving along the load
 //!   (closing) the drive only sets the reference the output is compared with (the output may
 //!   lag it by far more than the clearance, as the paper's cycle requires).
-//! - A drive along the load under a torque limit (the functional test's push, [`Drive`]'s
-//!   `torque_limit_nm`) is not a speed reference: it pushes the input with its limit `T`, the
-//!   input turns with the output, and the input ramp relieves the load face by `T` (pressing
-//!   `F_s + (|M| − T)·tanθ/r`) while the pack holds `M + T` (docs/model.md, "The `paper` reading").
+//! - A drive along the load under a torque limit (the functional test's push) pushes with its
+//!   limit `T`: the input turns with the output, the pack holds `M + T`, pressed by
+//!   `F_s + (|M| − T)·tanθ/r` (docs/model.md, "The `paper` reading").
 //! - An output that meets the engagement point at the input's speed with the drive on along
 //!   the load *tracks* the input (a Filippov sliding mode of the switch): it runs at the
 //!   reference speed with the pack holding exactly the load. Without this the switch chatters
@@ -63,9 +62,11 @@ pub struct Paper {
 impl Drive {
     /// Torque of a push along the load under a torque limit (N·m, ≥ 0); `None` when the drive is
     /// off, runs against the load or holds a speed reference.
-    fn limited_push_nm(&self, load_sign: f64) -> Option<f64> {
+    fn limited_push_nm(&self, load_sign: f64, motor_nm: f64) -> Option<f64> {
         let along = self.on && self.speed_ref_rad_s * load_sign > 0.0;
-        self.torque_limit_nm.filter(|_| along).map(|l| l.max(0.0))
+        self.torque_limit_nm
+            .filter(|_| along)
+            .map(|l| l.clamp(0.0, motor_nm))
     }
 }
 
@@ -135,7 +136,8 @@ impl Paper {
 
     /// The limited push's torque (N·m, ≥ 0), if the drive is pushing along the load.
     fn push_nm(&self) -> Option<f64> {
-        self.drive.limited_push_nm(self.load_sign())
+        self.drive
+            .limited_push_nm(self.load_sign(), self.cfg.drive_torque_limit_nm())
     }
 
     fn eval(&self, y: &[f64]) -> Eval {

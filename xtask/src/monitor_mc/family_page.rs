@@ -226,7 +226,7 @@ pub fn main(a: &FamilyArgs) -> Result<(), String> {
          how many that test ran (*tested*; functional-test.md); and, where any, those whose plant came apart \
          without the fault (*plant apart*, counted apart as a nominal run is; model.md, \
          \"The plant family\"). Functional tests failed: of the nominal runs the test \
-         followed (one in ten, `--test-every`), how many healthy units failed it, and how many \
+         followed (one in ten), how many healthy units failed it, and how many \
          healthy units their acceptance test against the design rejected. \
          Accuracy: the nominal reverse_load and forward_load runs where twin and monitor both \
          end locked, against issue 16's targets for a commissioned unit (holding torque within \

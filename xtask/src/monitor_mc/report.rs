@@ -117,8 +117,7 @@ pub fn build(meta: &Meta, outcomes: &[Outcome]) -> Result<Value, String> {
             })
             .collect();
         // Dormant: the fault never manifested in its scene; found by the drive's own cycle
-        // (`brake_degraded` in the run) or by the functional test after it (the physical form
-        // only can run it).
+        // (`brake_degraded` in the run) or by the functional test after it.
         let dormant: Vec<&Outcome> = runs.iter().copied().filter(|o| !o.manifested).collect();
         let tested: Vec<&Outcome> = dormant
             .iter()
