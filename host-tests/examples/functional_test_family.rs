@@ -13,7 +13,7 @@
 use host_tests::accuracy::{run_functional_test, scene_trace};
 use host_tests::dormant;
 use host_tests::family::{runs_and_seed, Family};
-use host_tests::mc::{draw_in, run_rng};
+use host_tests::mc::{commission_draw, draw_in, run_rng};
 use noback::monitor::functional_test::{TestConfig, TestResult};
 use noback::monitor::Config;
 use noback_twin::fault::{Fault, FaultKind};
@@ -49,6 +49,8 @@ fn main() -> Result<(), String> {
     let (mut healthy_c, mut faulted_max) = (Vec::new(), 0.0_f64);
     // Commissioned on both: the healthy re-tests' implied load over the set one, less one.
     let mut load_errors = Vec::new();
+    // Units whose acceptance test against the design failed (rejected in production).
+    let mut rejected = 0;
     for i in 0..runs {
         let d = draw_in(Family::Plant, seed, i, None);
         if d.scene.reading != form || d.scene.load_torque_nm < 2.0 {
@@ -61,7 +63,13 @@ fn main() -> Result<(), String> {
         };
         let start = DEFAULT_TEST.start_s;
         let accepted = scene_trace(&test_scene(&d.scene, load, None))?;
-        let r0 = run_functional_test(&accepted, Config::default(), &test, start)?;
+        // Commissioned as the Monte Carlo's commissioned column: on what acceptance identified.
+        let unit = commission_draw(&d).map_or(Config::default(), |c| c.config);
+        let r0 = run_functional_test(&accepted, unit, &test, start)?;
+        if r0.result != TestResult::Pass {
+            rejected += 1;
+            continue;
+        }
         let commissioned = test.commissioned(
             r0.breakaway_torque_nm.to_num::<f64>(),
             r0.opening_torque_nm.to_num::<f64>(),
@@ -87,7 +95,8 @@ fn main() -> Result<(), String> {
                 margins.push(r.margin.to_num::<f64>());
             }
             for (c, cfg) in [test, alone, commissioned].iter().enumerate() {
-                let r = run_functional_test(&trace, Config::default(), cfg, start)?;
+                let config = if c == 0 { Config::default() } else { unit };
+                let r = run_functional_test(&trace, config, cfg, start)?;
                 if c == 2 {
                     let m = r.margin.to_num::<f64>();
                     if fault.is_none() {
@@ -134,6 +143,7 @@ fn main() -> Result<(), String> {
         spread(&mut load_errors)
     );
     println!("commissioned on both: spring_broken margin max {faulted_max:.3}");
+    println!("rejected at acceptance: {rejected}");
     for (slot, name) in [
         "healthy",
         "spring_broken",

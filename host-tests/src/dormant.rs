@@ -79,23 +79,23 @@ pub enum Verdict {
 
 /// The functional test of draw `d`'s unit, commissioned on its healthy acceptance test, with
 /// the run's faults in place.
-pub fn functional_test_after(d: &Draw, config: Config) -> Result<Option<Verdict>, String> {
+pub fn functional_test_after(d: &Draw, config: Config) -> Result<Verdict, String> {
     let procedure = TestConfig::DEFAULT;
     let start = noback_twin::scene::DEFAULT_TEST.start_s;
     let mut rng = Rng::new(d.scene.noise.seed ^ 0x7e57);
     let mut accepted = test_scene(&d.scene, procedure.load_nm, &[]);
     accepted.noise.seed = rng.next_u64();
     let Some(commissioned) = accept(&scene_trace(&accepted)?, config, &procedure, start)? else {
-        return Ok(Some(Verdict::Rejected));
+        return Ok(Verdict::Rejected);
     };
     let load = procedure.load_nm * (1.0 + LOAD_TOLERANCE * (2.0 * rng.uniform() - 1.0));
     let mut in_service = test_scene(&d.scene, load, &d.scene.faults);
     in_service.noise.seed = rng.next_u64();
     let trace = scene_trace(&in_service)?;
     let r = run_functional_test(&trace, config, &commissioned, start)?;
-    Ok(Some(if r.result == TestResult::Pass {
+    Ok(if r.result == TestResult::Pass {
         Verdict::Pass
     } else {
         Verdict::Fail
-    }))
+    })
 }

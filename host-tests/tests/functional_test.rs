@@ -1,13 +1,13 @@
 //! The commanded functional test (issue 17) on the twin's `functional_test` scene: a healthy
 //! brake passes against the design's expectation; a unit commissioned on its own healthy test
 //! fails once its spring is half gone, passes at a load 5 % off (the opening takes it out) and
-//! fails when its current sensor reads half; a partial ramp jam fails even uncommissioned; the
-//! paper reading refuses the scene.
+//! fails when its current sensor reads half; a partial ramp jam fails even uncommissioned; on
+//! the paper reading a spring-only unit is judged on its breakaway.
 
 use host_tests::accuracy::{run_functional_test, scene_trace};
 use host_tests::dormant;
 use noback::monitor::functional_test::{TestConfig, TestResult};
-use noback::monitor::Config;
+use noback::monitor::{Config, DrivingPack};
 use noback::monitor::{ConfigError, Monitor};
 use noback_twin::fault::{Fault, FaultKind};
 use noback_twin::reading::Reading;
@@ -156,10 +156,46 @@ fn paper_report(
     test: &TestConfig,
     load_scale: f64,
 ) -> noback::monitor::functional_test::TestReport {
+    paper_report_on(Config::default(), fault, test, load_scale)
+}
+
+/// [`paper_report`] on a monitor configured as `config`.
+fn paper_report_on(
+    config: Config,
+    fault: Option<(FaultKind, f64)>,
+    test: &TestConfig,
+    load_scale: f64,
+) -> noback::monitor::functional_test::TestReport {
     let mut s = test_scene(fault, load_scale);
     s.reading = Reading::Paper;
     let trace = scene_trace(&s).unwrap();
-    run_functional_test(&trace, Config::default(), test, s.test.start_s).unwrap()
+    run_functional_test(&trace, config, test, s.test.start_s).unwrap()
+}
+
+/// A paper unit commissioned as what it is, a spring-only pack, is judged on its breakaway: a
+/// spring half gone reads as the capacity it lost. Taken for a relieved pack, the two readings'
+/// weights (set for a drag of a quarter of `C₀`) read the same loss as a gain.
+#[test]
+fn a_spring_only_unit_reads_a_lost_spring_as_a_loss() {
+    let spring_only = Config {
+        driving_pack: DrivingPack::SpringOnly,
+        ..Config::default()
+    };
+    for config in [spring_only, Config::default()] {
+        let healthy = paper_report_on(config, None, &TestConfig::DEFAULT, 1.0);
+        let unit = TestConfig::DEFAULT.commissioned(
+            healthy.breakaway_torque_nm.to_num(),
+            healthy.opening_torque_nm.to_num(),
+        );
+        let r = paper_report_on(config, Some((FaultKind::SpringBroken, 0.5)), &unit, 1.0);
+        let margin: f64 = r.margin.to_num();
+        if config.driving_pack == DrivingPack::SpringOnly {
+            assert!(margin < 0.95, "spring-only: {r:?}");
+            assert_eq!(r.result, TestResult::Fail, "{r:?}");
+        } else {
+            assert!(margin > 1.0, "taken for relieved: {r:?}");
+        }
+    }
 }
 
 /// On the paper form the opening drags the spring-clamped pack at its full capacity (the
@@ -192,5 +228,5 @@ fn the_paper_reading_runs_the_test_healthy_passes_and_dormant_faults_fail() {
 fn a_healthy_unit_whose_servo_dithers_at_rest_passes() {
     let d = host_tests::mc::draw_in(host_tests::family::Family::Plant, 6174, 8251, None);
     let verdict = dormant::functional_test_after(&d, Config::default()).expect("twin");
-    assert_eq!(verdict, Some(dormant::Verdict::Pass));
+    assert_eq!(verdict, dormant::Verdict::Pass);
 }

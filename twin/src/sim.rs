@@ -171,12 +171,7 @@ pub fn run_model_with<M: TwinModel>(
             let angle = samples.last().map_or(0.0, |s| s.output_angle_rad);
             let rest = *rest_angle.get_or_insert(angle);
             // Along the load only: the settle's own travel runs against it.
-            let sign = if scene.load_torque_nm < 0.0 {
-                -1.0
-            } else {
-                1.0
-            };
-            let along = (angle - rest) * sign;
+            let along = (angle - rest) * crate::model::load_sign(scene.load_torque_nm);
             aborted |= along >= scene.test.abort_angle_rad;
         }
         model.set_drive(scene_drive(scene, t, !aborted), &mut y);

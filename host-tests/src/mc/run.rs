@@ -145,7 +145,7 @@ pub fn evaluate(d: &Draw, campaign: &Campaign) -> Outcome {
         };
     let test = if tested {
         match functional_test_after(d, config) {
-            Ok(v) => v,
+            Ok(v) => Some(v),
             Err(e) => return fail(e),
         }
     } else {

@@ -43,6 +43,16 @@ pub struct ModelConfig {
     pub drive: Drive,
 }
 
+/// The load's direction on the output (±1; no load counts as positive): where its face rests
+/// and which way the functional test's push and abort count.
+pub fn load_sign(load_torque_nm: f64) -> f64 {
+    if load_torque_nm >= 0.0 {
+        1.0
+    } else {
+        -1.0
+    }
+}
+
 impl ModelConfig {
     /// Largest input-shaft torque the motor can give: its current limit through the reducer.
     pub fn drive_torque_limit_nm(&self) -> f64 {

@@ -107,11 +107,7 @@ impl Paper {
     }
 
     fn load_sign(&self) -> f64 {
-        if self.cfg.load_torque_nm >= 0.0 {
-            1.0
-        } else {
-            -1.0
-        }
+        super::load_sign(self.cfg.load_torque_nm)
     }
 
     /// The drive carries the output when it runs against the load (opening).

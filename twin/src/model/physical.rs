@@ -420,11 +420,7 @@ impl TwinModel for Physical {
         y[X_B] = xb;
         y[X_M] = xb + self.cfg.open.shaft_gap_m;
         // Output end: load face (plus) just touching: rc(θs − θc) + s(xo − xb) = g.
-        let load_sign = if self.cfg.load_torque_nm >= 0.0 {
-            1.0
-        } else {
-            -1.0
-        };
+        let load_sign = super::load_sign(self.cfg.load_torque_nm);
         y[THETA_S] = load_sign * g / rc;
         // Input end: the faces the drive torque loads, if the drive is on.
         let drive_sign = if self.drive.on {
