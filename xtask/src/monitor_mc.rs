@@ -453,6 +453,7 @@ pub fn report_of(
         monitor_digest: campaign.monitor_digest.clone(),
         config: setup.config,
         pre_roll_s: campaign.pre_roll_s,
+        test_every: campaign.test_every,
         commissioned: campaign.commissioned,
     };
     let mut report = report::build(&meta, outcomes)?;

@@ -33,6 +33,8 @@ pub struct Meta {
     pub monitor_digest: Option<String>,
     pub config: Config,
     pub pre_roll_s: f64,
+    /// The functional test followed one nominal run in this many (0: none).
+    pub test_every: u64,
     /// Each draw's unit commissioned on its acceptance runs.
     pub commissioned: bool,
 }
@@ -159,6 +161,7 @@ pub fn build(meta: &Meta, outcomes: &[Outcome]) -> Result<Value, String> {
         "monitor_digest": meta.monitor_digest,
         "power_on_settle_s": meta.config.thresholds.power_on_settle_s,
         "pre_roll_s": meta.pre_roll_s,
+        "test_every": meta.test_every,
         "nominal_runs": nominal.len(),
         "false_alarm_runs": false_alarm_runs,
         "false_alarm_rate": false_alarm,

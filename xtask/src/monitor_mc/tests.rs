@@ -327,7 +327,8 @@ fn a_fault_run_on_a_plant_apart_stays_apart_through_a_merge() {
 
 /// The committed certification campaign was run on the configuration this build ships for its
 /// family and on this build's monitor: a change to `Config` (its `Debug` text), or to what the
-/// monitor does on the campaign's first draws, without a rerun of the campaign fails here.
+/// monitor does on the campaign's first draws, without a rerun of the campaign fails here; so
+/// does a record of another campaign than the plan's (seed, family, test share).
 #[test]
 fn the_committed_campaign_is_of_this_builds_monitor() {
     let path = crate::shell::workspace_root().join(page::CAMPAIGN_RECORD);
@@ -345,6 +346,16 @@ fn the_committed_campaign_is_of_this_builds_monitor() {
     assert!(
         c["measured_on"].is_null(),
         "the record names an earlier monitor"
+    );
+    let plan = &page::CAMPAIGN_PLAN;
+    assert_eq!(
+        (
+            c["seed"].as_u64(),
+            c["test_every"].as_u64(),
+            c["plant_family"].as_str()
+        ),
+        (Some(plan.seed), Some(plan.test_every), Some(plan.family)),
+        "the record is not of the planned campaign (page::CAMPAIGN_PLAN)"
     );
     let mut setup = Setup::for_family(family);
     setup.pre_roll_s = c["pre_roll_s"].as_f64().expect("pre-roll");
