@@ -230,3 +230,13 @@ fn a_healthy_unit_whose_servo_dithers_at_rest_passes() {
     let verdict = dormant::functional_test_after(&d, Config::default()).expect("twin");
     assert_eq!(verdict, dormant::Verdict::Pass);
 }
+
+/// Certification campaign draw 27743 (seed 2718): its push ends a BDF step a hair past a sample
+/// segment's stop time, which diffsol answers with a negative step size and no interpolant; the
+/// twin samples that step from its two ends and the healthy unit passes.
+#[test]
+fn a_step_past_its_stop_time_does_not_end_the_twin() {
+    let d = host_tests::mc::draw_in(host_tests::family::Family::Plant, 2718, 27743, None);
+    let verdict = dormant::functional_test_after(&d, Config::default());
+    assert_eq!(verdict, Ok(dormant::Verdict::Pass));
+}

@@ -207,11 +207,17 @@ where
     let mut guard = EventLoopGuard::default();
     let mut steps = 0u64;
     solver.set_stop_time(t1).map_err(err(t0))?;
-    // At the step's own end (within rounding) the state itself: a step that lands a hair past the
-    // stop time leaves diffsol a negative step size, under which it refuses to interpolate.
-    let interp = |s: &Sol, tm: f64| -> Result<Vec<f64>, SolverError> {
-        if (s.state().t - tm).abs() <= 1e-12 * tm.abs().max(1.0) {
-            return Ok(s.state().y.clone_as_vec());
+    let mut start = StepStart::new(y.len());
+    // At the step's own end (within rounding) the state itself. A step that lands a hair past the
+    // stop time gets a negative step size from diffsol, which rescales (spoils) its interpolant and
+    // refuses it: inside that step, the cubic Hermite between the step's two ends instead.
+    let interp = |s: &Sol, start: &StepStart, tm: f64| -> Result<Vec<f64>, SolverError> {
+        let st = s.state();
+        if (st.t - tm).abs() <= 1e-12 * tm.abs().max(1.0) {
+            return Ok(st.y.clone_as_vec());
+        }
+        if st.h <= 0.0 && (start.t..st.t).contains(&tm) {
+            return Ok(start.hermite(st.t, &st.y.clone_as_vec(), &st.dy.clone_as_vec(), tm));
         }
         s.interpolate(tm).map(|v| v.clone_as_vec()).map_err(err(tm))
     };
@@ -220,6 +226,7 @@ where
         if steps > options.max_steps {
             return Err(SolverError::TooManySteps { t_s: t });
         }
+        start.record(solver.state().t, solver.state().y, solver.state().dy);
         let reason = solver.step().map_err(|e| SolverError::Diffsol {
             t_s: solver.state().t,
             message: e.to_string(),
@@ -234,7 +241,7 @@ where
                 // past the root (bisection on diffsol's interpolant up to the step end).
                 let (mut lo, mut hi) = (tr.min(t_hi), t_hi);
                 let first = |tm: f64, gm: &mut [f64]| -> Result<bool, SolverError> {
-                    let ym = interp(&solver, tm)?;
+                    let ym = interp(&solver, &start, tm)?;
                     cell.borrow().events(tm, &ym, gm);
                     Ok(g0.iter().zip(gm.iter()).any(|(&a, &b)| changed(a, b)))
                 };
@@ -259,12 +266,12 @@ where
         };
         while sampler.next_s <= t_end + 1e-12 * t_end.abs().max(1.0) && sampler.next_s <= t1 + 1e-12
         {
-            let ym = interp(&solver, sampler.next_s.min(t_step))?;
+            let ym = interp(&solver, &start, sampler.next_s.min(t_step))?;
             observe(&**cell.borrow(), sampler.next_s, &ym);
             sampler.next_s += sampler.dt_s;
         }
         if !fired.is_empty() {
-            let mut ye = interp(&solver, t_end)?;
+            let mut ye = interp(&solver, &start, t_end)?;
             cell.borrow_mut().on_event(t_end, &mut ye, &fired);
             if ye.iter().any(|v| !v.is_finite()) {
                 return Err(SolverError::NonFinite { t_s: t_end });
@@ -291,20 +298,56 @@ where
         }
         t = t_hi;
         if matches!(reason, OdeSolverStopReason::TstopReached) || t >= t1 {
-            let yl = interp(&solver, t)?;
+            let yl = interp(&solver, &start, t)?;
             y.copy_from_slice(&yl);
             break;
         }
         // A plain step, or a root with no sign change under the twin's rule (grazing): carry on,
         // with the next step shortened to the stop time again.
         guard.step();
-        let yl = interp(&solver, t)?;
+        let yl = interp(&solver, &start, t)?;
         cell.borrow().events(t, &yl, &mut g0);
         if matches!(reason, OdeSolverStopReason::RootFound(..)) {
             solver.set_stop_time(t1).map_err(err(t))?;
         }
     }
     Ok((solver.get_statistics().clone(), events))
+}
+
+/// The state where the step being taken began (diffsol keeps only the step's end).
+struct StepStart {
+    t: f64,
+    y: Vec<f64>,
+    dy: Vec<f64>,
+}
+
+impl StepStart {
+    fn new(n: usize) -> Self {
+        Self {
+            t: f64::NAN,
+            y: vec![0.0; n],
+            dy: vec![0.0; n],
+        }
+    }
+
+    fn record(&mut self, t: f64, y: &NalgebraVec<f64>, dy: &NalgebraVec<f64>) {
+        self.t = t;
+        for (i, (a, b)) in self.y.iter_mut().zip(self.dy.iter_mut()).enumerate() {
+            *a = y.get_index(i);
+            *b = dy.get_index(i);
+        }
+    }
+
+    /// The cubic Hermite through this start and the end `(t1, y1, dy1)`, at `t` between them.
+    fn hermite(&self, t1: f64, y1: &[f64], dy1: &[f64], t: f64) -> Vec<f64> {
+        let h = t1 - self.t;
+        let s = (t - self.t) / h;
+        let (h00, h10) = ((1.0 + 2.0 * s) * (1.0 - s).powi(2), s * (1.0 - s).powi(2));
+        let (h01, h11) = (s * s * (3.0 - 2.0 * s), s * s * (s - 1.0));
+        (0..self.y.len())
+            .map(|i| h00 * self.y[i] + h10 * h * self.dy[i] + h01 * y1[i] + h11 * h * dy1[i])
+            .collect()
+    }
 }
 
 #[cfg(test)]
@@ -428,5 +471,20 @@ mod tests {
         let mut smp = Sampler::none();
         let r = integ.integrate(&mut Blow, (0.0, 2.0), &mut y, &mut smp, &mut |_, _, _| {});
         assert!(r.is_err(), "{y:?}");
+    }
+
+    #[test]
+    fn the_step_fallback_is_exact_on_a_cubic() {
+        // y = t³ − 2t, y' = 3t² − 2 on [0.5, 1.5].
+        let (y, dy) = (|t: f64| t * t * t - 2.0 * t, |t: f64| 3.0 * t * t - 2.0);
+        let start = StepStart {
+            t: 0.5,
+            y: vec![y(0.5)],
+            dy: vec![dy(0.5)],
+        };
+        for t in [0.5, 0.7, 1.0, 1.31, 1.5] {
+            let v = start.hermite(1.5, &[y(1.5)], &[dy(1.5)], t)[0];
+            assert!((v - y(t)).abs() < 1e-12, "{t}: {v} vs {}", y(t));
+        }
     }
 }
