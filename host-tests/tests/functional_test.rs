@@ -233,7 +233,8 @@ fn a_healthy_unit_whose_servo_dithers_at_rest_passes() {
 
 /// Certification campaign draw 27743 (seed 2718): its push ends a BDF step a hair past a sample
 /// segment's stop time, which diffsol answers with a negative step size and no interpolant; the
-/// twin samples that step from its two ends and the healthy unit passes.
+/// twin samples that step from its two ends and the healthy unit passes. (A twin change that
+/// moves this step no longer reaches the fallback; the integrator's unit test keeps its formula.)
 #[test]
 fn a_step_past_its_stop_time_does_not_end_the_twin() {
     let d = host_tests::mc::draw_in(host_tests::family::Family::Plant, 2718, 27743, None);

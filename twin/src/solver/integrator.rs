@@ -209,15 +209,19 @@ where
     solver.set_stop_time(t1).map_err(err(t0))?;
     let mut start = StepStart::new(y.len());
     // At the step's own end (within rounding) the state itself. A step that lands a hair past the
-    // stop time gets a negative step size from diffsol, which rescales (spoils) its interpolant and
-    // refuses it: inside that step, the cubic Hermite between the step's two ends instead.
+    // stop time gets a negative step size from diffsol, which then refuses to interpolate in it
+    // (BDF also rescales its history): there, the cubic Hermite with the system's own slopes.
     let interp = |s: &Sol, start: &StepStart, tm: f64| -> Result<Vec<f64>, SolverError> {
         let st = s.state();
         if (st.t - tm).abs() <= 1e-12 * tm.abs().max(1.0) {
             return Ok(st.y.clone_as_vec());
         }
         if st.h <= 0.0 && (start.t..st.t).contains(&tm) {
-            return Ok(start.hermite(st.t, &st.y.clone_as_vec(), &st.dy.clone_as_vec(), tm));
+            let y1 = st.y.clone_as_vec();
+            let (mut dy0, mut dy1) = (vec![0.0; y1.len()], vec![0.0; y1.len()]);
+            cell.borrow().rhs(start.t, &start.y, &mut dy0);
+            cell.borrow().rhs(st.t, &y1, &mut dy1);
+            return Ok(start.hermite(&dy0, (st.t, &y1, &dy1), tm));
         }
         s.interpolate(tm).map(|v| v.clone_as_vec()).map_err(err(tm))
     };
@@ -226,7 +230,7 @@ where
         if steps > options.max_steps {
             return Err(SolverError::TooManySteps { t_s: t });
         }
-        start.record(solver.state().t, solver.state().y, solver.state().dy);
+        start.record(solver.state().t, solver.state().y);
         let reason = solver.step().map_err(|e| SolverError::Diffsol {
             t_s: solver.state().t,
             message: e.to_string(),
@@ -318,7 +322,6 @@ where
 struct StepStart {
     t: f64,
     y: Vec<f64>,
-    dy: Vec<f64>,
 }
 
 impl StepStart {
@@ -326,26 +329,25 @@ impl StepStart {
         Self {
             t: f64::NAN,
             y: vec![0.0; n],
-            dy: vec![0.0; n],
         }
     }
 
-    fn record(&mut self, t: f64, y: &NalgebraVec<f64>, dy: &NalgebraVec<f64>) {
+    fn record(&mut self, t: f64, y: &NalgebraVec<f64>) {
         self.t = t;
-        for (i, (a, b)) in self.y.iter_mut().zip(self.dy.iter_mut()).enumerate() {
+        for (i, a) in self.y.iter_mut().enumerate() {
             *a = y.get_index(i);
-            *b = dy.get_index(i);
         }
     }
 
-    /// The cubic Hermite through this start and the end `(t1, y1, dy1)`, at `t` between them.
-    fn hermite(&self, t1: f64, y1: &[f64], dy1: &[f64], t: f64) -> Vec<f64> {
+    /// The cubic Hermite through this start (slope `dy0`) and the end `(t1, y1, dy1)`, at `t`
+    /// between them.
+    fn hermite(&self, dy0: &[f64], (t1, y1, dy1): (f64, &[f64], &[f64]), t: f64) -> Vec<f64> {
         let h = t1 - self.t;
         let s = (t - self.t) / h;
         let (h00, h10) = ((1.0 + 2.0 * s) * (1.0 - s).powi(2), s * (1.0 - s).powi(2));
         let (h01, h11) = (s * s * (3.0 - 2.0 * s), s * s * (s - 1.0));
         (0..self.y.len())
-            .map(|i| h00 * self.y[i] + h10 * h * self.dy[i] + h01 * y1[i] + h11 * h * dy1[i])
+            .map(|i| h00 * self.y[i] + h10 * h * dy0[i] + h01 * y1[i] + h11 * h * dy1[i])
             .collect()
     }
 }
@@ -480,10 +482,9 @@ mod tests {
         let start = StepStart {
             t: 0.5,
             y: vec![y(0.5)],
-            dy: vec![dy(0.5)],
         };
         for t in [0.5, 0.7, 1.0, 1.31, 1.5] {
-            let v = start.hermite(1.5, &[y(1.5)], &[dy(1.5)], t)[0];
+            let v = start.hermite(&[dy(0.5)], (1.5, &[y(1.5)], &[dy(1.5)]), t)[0];
             assert!((v - y(t)).abs() < 1e-12, "{t}: {v} vs {}", y(t));
         }
     }

@@ -289,7 +289,9 @@ mod tests {
         // braking block (title and seven rows), refused, not driven, twin errors.
         assert_eq!(rows.len(), 1 + 2 + FAULT_KINDS.len() + 2 + 8 + 3, "{s}");
         for form in FORMS {
-            assert_eq!(unc[form]["errors"].as_u64(), Some(0), "{form}: {s}");
+            for c in [&unc, &com] {
+                assert_eq!(c[form]["errors"].as_u64(), Some(0), "{form}: {s}");
+            }
         }
         for form in FORMS {
             let fa = &unc[form]["false_alarm_with_command"]["of"];
