@@ -12,6 +12,7 @@
 use crate::board::SampleSource;
 use crate::digest::Fnv1a;
 use crate::event_log::{Event, EventLog};
+use crate::monitor::functional_test::Procedure;
 use crate::monitor::{Estimate, Flags, Inputs, Monitor};
 use embedded_hal::digital::OutputPin;
 
@@ -43,8 +44,8 @@ pub struct Ticker<S, P, const N: usize = LOG_CAPACITY> {
     digest: Fnv1a,
     last: Option<Estimate>,
     last_inputs: Option<Inputs>,
-    /// The tick at which the crew requests the functional test (`u32::MAX`: never).
-    test_at: u32,
+    /// The tick at which the crew requests the functional test (`u32::MAX`: never), and which.
+    test_at: (u32, Procedure),
 }
 
 /// Counters a run reports at its end.
@@ -83,13 +84,14 @@ impl<S: SampleSource, P: OutputPin, const N: usize> Ticker<S, P, N> {
             digest: Fnv1a::new(),
             last: None,
             last_inputs: None,
-            test_at: u32::MAX,
+            test_at: (u32::MAX, Procedure::Loaded),
         }
     }
 
-    /// Requests the monitor's functional test before tick `tick` (counted from 0) steps.
-    pub fn request_functional_test_at(&mut self, tick: u32) {
-        self.test_at = tick;
+    /// Requests the monitor's functional test of `procedure` before tick `tick` (counted from 0)
+    /// steps.
+    pub fn request_functional_test_at(&mut self, tick: u32, procedure: Procedure) {
+        self.test_at = (tick, procedure);
     }
 
     /// One tick. `ticks_elapsed` is 1 when on time, `n > 1` after a missed deadline. Returns
@@ -109,8 +111,9 @@ impl<S: SampleSource, P: OutputPin, const N: usize> Ticker<S, P, N> {
         let mut inputs = self.source.sample()?;
         inputs.ticks_elapsed = n;
         self.last_inputs = Some(inputs);
-        if self.ticks == self.test_at {
-            self.monitor.request_functional_test();
+        if self.ticks == self.test_at.0 {
+            // Refused (nothing started) when the configuration has no such procedure.
+            let _ = self.monitor.request_functional_test(self.test_at.1);
         }
         let estimate = *self.monitor.tick(&inputs);
         self.ticks = self.ticks.saturating_add(1);

@@ -91,7 +91,7 @@ use crate::fx::Q16;
 use aiding::Cut;
 use checks::{BrakingTick, CheckInputs, Checks};
 use estimate::{Energy, PackInputs};
-use functional_test::{FunctionalTest, TestReport};
+use functional_test::{FunctionalTest, Procedure, TestReport};
 use load::Load;
 use observe::{Observe, Observed};
 use pack::Dir;
@@ -221,11 +221,18 @@ impl Monitor {
         self.state.flags
     }
 
-    /// Starts the commanded functional test with this tick's slow-lane work (the ground crew's
-    /// request; the drive runs the ramp of `Config::functional_test`). A test already run is
-    /// started afresh.
-    pub fn request_functional_test(&mut self) {
-        self.state.test = Some(FunctionalTest::new());
+    /// Starts the commanded functional test of `procedure` with this tick's slow-lane work (the
+    /// ground crew's request; the drive runs its ramp). A test already run is started afresh.
+    /// `false` (nothing started) if the configuration has no such procedure.
+    pub fn request_functional_test(&mut self, procedure: Procedure) -> bool {
+        let configured = match procedure {
+            Procedure::Loaded => true,
+            Procedure::Uncoupled => self.settings.uncoupled_test.is_some(),
+        };
+        if configured {
+            self.state.test = Some(FunctionalTest::new(procedure));
+        }
+        configured
     }
 
     /// The functional test's report, once requested.
@@ -375,7 +382,13 @@ impl Monitor {
         (st.gave_way, st.reading_switch) = (gave_way, reading_switch);
         st.latch(raised.union(fast));
         if let Some(test) = st.test.as_mut() {
-            test.step(&k.functional_test, x, o.drive_torque, st.flags);
+            let settings = match test.procedure() {
+                Procedure::Loaded => Some(&k.functional_test),
+                Procedure::Uncoupled => k.uncoupled_test.as_ref(),
+            };
+            if let Some(s) = settings {
+                test.step(s, x, o.drive_torque, st.flags);
+            }
         }
     }
 }

@@ -18,7 +18,7 @@ use host_tests::accuracy::{run_functional_test, scene_trace};
 use host_tests::dormant;
 use host_tests::family::{runs_and_seed, Family};
 use host_tests::mc::{commission_draw, draw_in, run_rng};
-use noback::monitor::functional_test::{TestConfig, TestResult};
+use noback::monitor::functional_test::{Procedure, TestConfig, TestResult};
 use noback::monitor::Config;
 use noback_twin::fault::{Fault, FaultKind};
 use noback_twin::reading::Reading;
@@ -78,7 +78,7 @@ fn main() -> Result<(), String> {
         let accepted = scene_trace(&test_scene(&d.scene, load, None))?;
         // Commissioned as the Monte Carlo's commissioned column: on what acceptance identified.
         let unit = commission_draw(&d).map_or(Config::default(), |c| c.config);
-        let r0 = run_functional_test(&accepted, unit, &test, start)?;
+        let r0 = run_functional_test(&accepted, unit, (Procedure::Loaded, &test), start)?;
         // At a set load the design's expectation does not apply: the unit's own breakaway is
         // its reference, and only a unit that never broke away is counted rejected.
         let reference = set_load.is_some() && r0.breakaway_torque_nm.to_num::<f64>() > 0.0;
@@ -107,12 +107,17 @@ fn main() -> Result<(), String> {
             scene.noise.seed = rng.next_u64();
             let trace = scene_trace(&scene)?;
             if fault.is_none() {
-                let r = run_functional_test(&trace, Config::default(), &test, start)?;
+                let r = run_functional_test(
+                    &trace,
+                    Config::default(),
+                    (Procedure::Loaded, &test),
+                    start,
+                )?;
                 margins.push(r.margin.to_num::<f64>());
             }
             for (c, cfg) in [test, alone, commissioned].iter().enumerate() {
                 let config = if c == 0 { Config::default() } else { unit };
-                let r = run_functional_test(&trace, config, cfg, start)?;
+                let r = run_functional_test(&trace, config, (Procedure::Loaded, cfg), start)?;
                 if c == 2 {
                     let m = r.margin.to_num::<f64>();
                     if fault.is_none() {

@@ -13,7 +13,7 @@
 //! - lock time: first sample after the drive is cut at which the brake state is locked and
 //!   stays locked for [`LOCK_CONFIRM_S`].
 
-use noback::monitor::functional_test::{TestConfig, TestReport};
+use noback::monitor::functional_test::{Procedure, TestConfig, TestReport};
 use noback::monitor::{BrakeState, Config, Estimate, Flags, Inputs, Monitor};
 use noback_twin::fault::{Fault, FaultKind};
 use noback_twin::trace::Trace;
@@ -75,20 +75,23 @@ pub fn run_monitor_with(
         .collect())
 }
 
-/// The functional test's report after running the monitor over `trace` with `test` as its
-/// procedure and the crew's request at `start_s`.
+/// The functional test's report after running the monitor over `trace` with `test` as the
+/// procedure of its kind and the crew's request at `start_s`.
 pub fn run_functional_test(
     trace: &Trace,
     mut config: Config,
-    test: &TestConfig,
+    (kind, test): (Procedure, &TestConfig),
     start_s: f64,
 ) -> Result<TestReport, String> {
-    config.functional_test = *test;
+    match kind {
+        Procedure::Loaded => config.functional_test = *test,
+        Procedure::Uncoupled => config.uncoupled_test = Some(*test),
+    }
     let mut monitor = Monitor::new(config).map_err(|e| format!("monitor config: {e:?}"))?;
     let start = (start_s * trace.sample_rate_hz).round() as usize;
     for (i, r) in trace.rows.iter().enumerate() {
-        if i == start {
-            monitor.request_functional_test();
+        if i == start && !monitor.request_functional_test(kind) {
+            return Err(format!("no {kind:?} functional test configured"));
         }
         monitor.step(&Inputs::new(
             r.current_code,

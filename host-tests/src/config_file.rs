@@ -18,6 +18,8 @@
 //! expected_breakaway_nm = 11.0   # the unit's acceptance test (absent: the design's)
 //! expected_opening_nm = 24.8     # and its opening torque (needs the breakaway)
 //! min_margin = 0.95
+//! [monitor.uncoupled_test]       # a spring-only pack's push with the output uncoupled (its
+//! expected_breakaway_nm = 8.2    # fields as above, over `TestConfig::UNCOUPLED`; absent: none)
 //! [monitor.aiding_braking]       # a spring-only pack's braking (AidingBraking), all three
 //! inertia_kg_m2 = 0.15
 //! drag_nm = 8.4
@@ -100,21 +102,41 @@ fn acceptance_fields(t: &mut TestConfig) -> [(&'static str, &mut Option<f64>); 2
     ]
 }
 
-/// `[monitor.functional_test]` over the defaults.
-fn functional_test(mut given: Table) -> Result<TestConfig, String> {
-    let mut t = TestConfig::DEFAULT;
+/// A functional test's table (`path`: `monitor.functional_test` or `monitor.uncoupled_test`)
+/// over its procedure's defaults `base`.
+fn test_table(mut given: Table, base: TestConfig, path: &str) -> Result<TestConfig, String> {
+    let mut t = base;
     for (key, field) in test_fields(&mut t) {
         if let Some(v) = given.remove(key) {
-            *field = number(&v, &format!("monitor.functional_test.{key}"))?;
+            *field = number(&v, &format!("{path}.{key}"))?;
         }
     }
     for (key, field) in acceptance_fields(&mut t) {
         if let Some(v) = given.remove(key) {
-            *field = Some(number(&v, &format!("monitor.functional_test.{key}"))?);
+            *field = Some(number(&v, &format!("{path}.{key}"))?);
         }
     }
-    no_more(&given, "monitor.functional_test.")?;
+    no_more(&given, &format!("{path}."))?;
     Ok(t)
+}
+
+/// A functional test's lines: the fields that differ from `base`, then the acceptance readings.
+fn test_lines(mut base: TestConfig, mut now: TestConfig) -> String {
+    let mut test = String::new();
+    for ((key, b), (_, v)) in test_fields(&mut base)
+        .into_iter()
+        .zip(test_fields(&mut now))
+    {
+        if *b != *v {
+            test.push_str(&format!("{key} = {v:?}\n"));
+        }
+    }
+    for (key, v) in acceptance_fields(&mut now) {
+        if let Some(v) = v {
+            test.push_str(&format!("{key} = {v:?}\n"));
+        }
+    }
+    test
 }
 
 /// A table whose every one of `keys` is given (and nothing else), in `keys`' order.
@@ -154,7 +176,12 @@ pub fn parse(text: &str) -> Result<Config, String> {
         c.thresholds = thresholds(c.thresholds, table(t, "monitor.thresholds")?)?;
     }
     if let Some(t) = m.remove("functional_test") {
-        c.functional_test = functional_test(table(t, "monitor.functional_test")?)?;
+        let path = "monitor.functional_test";
+        c.functional_test = test_table(table(t, path)?, TestConfig::DEFAULT, path)?;
+    }
+    if let Some(t) = m.remove("uncoupled_test") {
+        let path = "monitor.uncoupled_test";
+        c.uncoupled_test = Some(test_table(table(t, path)?, TestConfig::UNCOUPLED, path)?);
     }
     if let Some(t) = m.remove("aiding_braking") {
         let path = "monitor.aiding_braking";
@@ -256,25 +283,14 @@ pub fn write(c: &Config, comment: &str) -> Result<String, String> {
             }
         }
     }
-    let (mut base, mut now) = (TestConfig::DEFAULT, c.functional_test);
-    let mut test = String::new();
-    for ((key, b), (_, v)) in test_fields(&mut base)
-        .into_iter()
-        .zip(test_fields(&mut now))
-    {
-        if *b != *v {
-            test.push_str(&format!("{key} = {v:?}\n"));
-        }
-    }
-    let mut now = c.functional_test;
-    for (key, v) in acceptance_fields(&mut now) {
-        if let Some(v) = v {
-            test.push_str(&format!("{key} = {v:?}\n"));
-        }
-    }
+    let test = test_lines(TestConfig::DEFAULT, c.functional_test);
     if !test.is_empty() {
         out.push_str("[monitor.functional_test]\n");
         out.push_str(&test);
+    }
+    if let Some(t) = c.uncoupled_test {
+        out.push_str("[monitor.uncoupled_test]\n");
+        out.push_str(&test_lines(TestConfig::UNCOUPLED, t));
     }
     if let Some(a) = c.aiding_braking {
         out.push_str(&format!(
@@ -330,6 +346,7 @@ mod tests {
             ..TestConfig::DEFAULT
         }
         .commissioned(10.25, 24.5);
+        c.uncoupled_test = Some(TestConfig::UNCOUPLED.commissioned(8.125, 1.5));
         c.aiding_braking = Some(AidingBraking {
             inertia_kg_m2: 0.1512345,
             drag_nm: 8.25,
@@ -376,6 +393,12 @@ mod tests {
                 "[monitor.functional_test]\nmin_margin = 2\n",
                 "functional_test.min_margin",
             ),
+            (
+                "[monitor]\ndriving_pack = \"spring_only\"\n[monitor.uncoupled_test]\nmin_margin = 2\n",
+                "uncoupled_test.min_margin",
+            ),
+            // The uncoupled push is a spring-only pack's.
+            ("[monitor.uncoupled_test]\n", "uncoupled_test"),
         ] {
             let e = parse(text).unwrap_err();
             assert!(e.contains(key), "{text:?}: {e}");

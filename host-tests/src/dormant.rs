@@ -1,13 +1,15 @@
 //! The commanded functional test on the host (docs/functional-test.md): a scene's procedure, a
 //! unit's acceptance, and the test at the end of a Monte Carlo run that finds dormant faults
 //! (docs/monitor.md). There the unit is commissioned by its healthy acceptance test at the
-//! procedure's load; in service the test runs with the run's faults in place, at a load within
-//! ±5 % of the procedure's and with fresh sensor noise, on the draw's own reading.
+//! procedure's load (and a spring-only unit by its uncoupled push too); in service the tests run
+//! with the run's faults in place, at a load within ±5 % of the procedure's (the uncoupled push's
+//! within ±0.05 N·m) and with fresh sensor noise, on the draw's own reading.
 
 use crate::accuracy::{run_functional_test, scene_trace};
 use crate::mc::Draw;
-use noback::monitor::functional_test::{TestConfig, TestResult};
-use noback::monitor::Config;
+use noback::fx::Q16;
+use noback::monitor::functional_test::{Procedure, TestConfig, TestResult};
+use noback::monitor::{Config, DrivingPack};
 use noback_twin::fault::{Fault, FaultKind};
 use noback_twin::scene::{Scene, SceneKind};
 use noback_twin::sensing::Rng;
@@ -15,6 +17,13 @@ use noback_twin::trace::Trace;
 
 /// How far the in-service test's load may lie from the procedure's (fraction).
 pub const LOAD_TOLERANCE: f64 = 0.05;
+
+/// How far the uncoupled push's set torque may lie from the procedure's (N·m): a weight on a
+/// lever, not a door.
+pub const UNCOUPLED_LOAD_TOLERANCE_NM: f64 = 0.05;
+
+/// A `functional_test` scene at a load this small (N·m) is the uncoupled push.
+pub const UNCOUPLED_MAX_LOAD_NM: f64 = 1.0;
 
 /// A `functional_test` scene of `base`'s plant (mechanism, sensors, noise, open items) at
 /// `load_nm`, with `faults` in place from the start.
@@ -30,29 +39,45 @@ pub fn test_scene(base: &Scene, load_nm: f64, faults: &[Fault]) -> Scene {
     s
 }
 
-/// The procedure a `functional_test` scene runs: its load and its drive's ramp.
-pub fn procedure_of(scene: &Scene) -> TestConfig {
-    TestConfig {
+/// The procedure a `functional_test` scene runs: uncoupled at a load within
+/// [`UNCOUPLED_MAX_LOAD_NM`], else loaded; its load and its drive's ramp.
+pub fn procedure_of(scene: &Scene) -> (Procedure, TestConfig) {
+    let (procedure, base) = if scene.load_torque_nm.abs() <= UNCOUPLED_MAX_LOAD_NM {
+        (Procedure::Uncoupled, TestConfig::UNCOUPLED)
+    } else {
+        (Procedure::Loaded, TestConfig::DEFAULT)
+    };
+    let test = TestConfig {
         load_nm: scene.load_torque_nm,
         torque_rate_nm_s: scene.test.torque_rate_nm_s,
         max_torque_nm: scene.test.torque_max_nm,
         open_s: scene.test.open_s,
         settle_s: scene.test.settle_s,
-        ..TestConfig::DEFAULT
-    }
+        ..base
+    };
+    (procedure, test)
 }
 
-/// The acceptance test: `procedure` run on a healthy unit's `trace` (requested at `start_s`)
-/// against the design; if it passes, the procedure commissioned on its breakaway and opening
-/// torques, else `None`.
+/// The acceptance test: `procedure` run on a healthy unit's `trace` (requested at `start_s`);
+/// the procedure commissioned on its breakaway and opening torques if the unit passed against
+/// the design (the loaded push) or broke away at all (the uncoupled push, which the design does
+/// not predict: docs/functional-test.md), else `None`.
 pub fn accept(
     trace: &Trace,
     config: Config,
-    procedure: &TestConfig,
+    (kind, procedure): (Procedure, &TestConfig),
     start_s: f64,
 ) -> Result<Option<TestConfig>, String> {
-    let r = run_functional_test(trace, config, procedure, start_s)?;
-    Ok((r.result == TestResult::Pass).then(|| {
+    let r = run_functional_test(trace, config, (kind, procedure), start_s)?;
+    let accepted = match kind {
+        Procedure::Loaded => r.result == TestResult::Pass,
+        Procedure::Uncoupled => {
+            r.result != TestResult::Aborted
+                && r.breakaway_torque_nm > Q16::ZERO
+                && r.capacity_nm > Q16::ZERO
+        }
+    };
+    Ok(accepted.then(|| {
         procedure.commissioned(r.breakaway_torque_nm.to_num(), r.opening_torque_nm.to_num())
     }))
 }
@@ -78,24 +103,50 @@ pub enum Verdict {
 }
 
 /// The functional test of draw `d`'s unit, commissioned on its healthy acceptance test, with
-/// the run's faults in place.
+/// the run's faults in place; a unit commissioned as a spring-only pack is also pushed
+/// uncoupled, and fails if either test fails.
 pub fn functional_test_after(d: &Draw, config: Config) -> Result<Verdict, String> {
-    let procedure = TestConfig::DEFAULT;
     let start = noback_twin::scene::DEFAULT_TEST.start_s;
-    let mut rng = Rng::new(d.scene.noise.seed ^ 0x7e57);
-    let mut accepted = test_scene(&d.scene, procedure.load_nm, &[]);
-    accepted.noise.seed = rng.next_u64();
-    let Some(commissioned) = accept(&scene_trace(&accepted)?, config, &procedure, start)? else {
-        return Ok(Verdict::Rejected);
-    };
-    let load = procedure.load_nm * (1.0 + LOAD_TOLERANCE * (2.0 * rng.uniform() - 1.0));
-    let mut in_service = test_scene(&d.scene, load, &d.scene.faults);
-    in_service.noise.seed = rng.next_u64();
-    let trace = scene_trace(&in_service)?;
-    let r = run_functional_test(&trace, config, &commissioned, start)?;
-    Ok(if r.result == TestResult::Pass {
-        Verdict::Pass
-    } else {
-        Verdict::Fail
-    })
+    let seed = d.scene.noise.seed ^ 0x7e57;
+    // Each procedure draws its noise and load from its own stream.
+    let mut procedures = vec![(
+        Procedure::Loaded,
+        TestConfig::DEFAULT,
+        LOAD_TOLERANCE,
+        Rng::new(seed),
+    )];
+    if config.driving_pack == DrivingPack::SpringOnly {
+        let tolerance = UNCOUPLED_LOAD_TOLERANCE_NM / TestConfig::UNCOUPLED.load_nm;
+        let rng = Rng::new(seed ^ 0x0c0_1ed);
+        procedures.push((Procedure::Uncoupled, TestConfig::UNCOUPLED, tolerance, rng));
+    }
+    // Acceptance: every procedure on the healthy unit.
+    let mut unit = config;
+    for (kind, procedure, _, rng) in &mut procedures {
+        let mut accepted = test_scene(&d.scene, procedure.load_nm, &[]);
+        accepted.noise.seed = rng.next_u64();
+        let trace = scene_trace(&accepted)?;
+        let Some(commissioned) = accept(&trace, unit, (*kind, procedure), start)? else {
+            return Ok(Verdict::Rejected);
+        };
+        match kind {
+            Procedure::Loaded => unit.functional_test = commissioned,
+            Procedure::Uncoupled => unit.uncoupled_test = Some(commissioned),
+        }
+    }
+    // In service: each procedure at a load within its tolerance, with the run's faults.
+    for (kind, procedure, tolerance, rng) in &mut procedures {
+        let load = procedure.load_nm * (1.0 + *tolerance * (2.0 * rng.uniform() - 1.0));
+        let mut in_service = test_scene(&d.scene, load, &d.scene.faults);
+        in_service.noise.seed = rng.next_u64();
+        let trace = scene_trace(&in_service)?;
+        let test = match kind {
+            Procedure::Loaded => unit.functional_test,
+            Procedure::Uncoupled => unit.uncoupled_test.unwrap_or(*procedure),
+        };
+        if run_functional_test(&trace, unit, (*kind, &test), start)?.result != TestResult::Pass {
+            return Ok(Verdict::Fail);
+        }
+    }
+    Ok(Verdict::Pass)
 }

@@ -6,7 +6,7 @@
 
 use host_tests::accuracy::{run_functional_test, scene_trace};
 use host_tests::dormant;
-use noback::monitor::functional_test::{TestConfig, TestResult};
+use noback::monitor::functional_test::{Procedure, TestConfig, TestResult};
 use noback::monitor::{Config, DrivingPack};
 use noback::monitor::{ConfigError, Monitor};
 use noback_twin::fault::{Fault, FaultKind};
@@ -36,7 +36,13 @@ fn report_at(
 ) -> noback::monitor::functional_test::TestReport {
     let s = test_scene(fault, load_scale);
     let trace = scene_trace(&s).unwrap();
-    run_functional_test(&trace, Config::default(), test, s.test.start_s).unwrap()
+    run_functional_test(
+        &trace,
+        Config::default(),
+        (Procedure::Loaded, test),
+        s.test.start_s,
+    )
+    .unwrap()
 }
 
 /// The procedure commissioned on the healthy unit's own acceptance test.
@@ -169,7 +175,7 @@ fn paper_report_on(
     let mut s = test_scene(fault, load_scale);
     s.reading = Reading::Paper;
     let trace = scene_trace(&s).unwrap();
-    run_functional_test(&trace, config, test, s.test.start_s).unwrap()
+    run_functional_test(&trace, config, (Procedure::Loaded, test), s.test.start_s).unwrap()
 }
 
 /// A paper unit commissioned as what it is, a spring-only pack, is judged on its breakaway: a
@@ -240,4 +246,92 @@ fn a_step_past_its_stop_time_does_not_end_the_twin() {
     let d = host_tests::mc::draw_in(host_tests::family::Family::Plant, 2718, 27743, None);
     let verdict = dormant::functional_test_after(&d, Config::default());
     assert_eq!(verdict, Ok(dormant::Verdict::Pass));
+}
+
+/// The uncoupled push on a paper unit commissioned as a spring-only pack, at `load_nm`.
+fn uncoupled_report(
+    config: Config,
+    fault: Option<(FaultKind, f64)>,
+    load_nm: f64,
+) -> noback::monitor::functional_test::TestReport {
+    let mut s = test_scene(fault, 1.0);
+    s.reading = Reading::Paper;
+    s.load_torque_nm = load_nm;
+    let trace = scene_trace(&s).unwrap();
+    let test = config.uncoupled_test.unwrap();
+    run_functional_test(
+        &trace,
+        config,
+        (Procedure::Uncoupled, &test),
+        s.test.start_s,
+    )
+    .unwrap()
+}
+
+/// With no door load to misjudge, a spring-only pack's breakaway is its spring's clamp: the
+/// uncoupled push passes the healthy unit at a set torque ±0.05 N·m off and fails a pack worn
+/// by half, which moves the loaded push by less than the door load's ±5 % does
+/// (docs/functional-test.md, "The uncoupled push").
+#[test]
+fn the_uncoupled_push_finds_a_worn_spring_only_pack() {
+    let mut unit = Config {
+        driving_pack: DrivingPack::SpringOnly,
+        uncoupled_test: Some(TestConfig::UNCOUPLED),
+        ..Config::default()
+    };
+    let mut s = test_scene(None, 1.0);
+    s.reading = Reading::Paper;
+    s.load_torque_nm = TestConfig::UNCOUPLED.load_nm;
+    let accepted = dormant::accept(
+        &scene_trace(&s).unwrap(),
+        unit,
+        (Procedure::Uncoupled, &TestConfig::UNCOUPLED),
+        s.test.start_s,
+    )
+    .unwrap();
+    unit.uncoupled_test = accepted;
+    assert!(unit.uncoupled_test.is_some(), "the healthy unit broke away");
+    for load in [0.25, 0.35] {
+        let r = uncoupled_report(unit, None, load);
+        assert_eq!(r.result, TestResult::Pass, "healthy at {load} N·m: {r:?}");
+        assert_eq!(r.procedure, Procedure::Uncoupled);
+    }
+    for fault in [(FaultKind::PackWear, 0.5), (FaultKind::SpringBroken, 0.5)] {
+        let r = uncoupled_report(unit, Some(fault), 0.3);
+        assert_eq!(r.result, TestResult::Fail, "{fault:?}: {r:?}");
+    }
+}
+
+/// The uncoupled push is a spring-only pack's: configured on a relieved one it is refused, and
+/// requested where none is configured nothing starts.
+#[test]
+fn the_uncoupled_push_needs_a_spring_only_unit() {
+    let relieved = Config {
+        uncoupled_test: Some(TestConfig::UNCOUPLED),
+        ..Config::default()
+    };
+    assert_eq!(
+        Monitor::new(relieved).err(),
+        Some(ConfigError::OutOfRange {
+            parameter: "uncoupled_test"
+        })
+    );
+    let bad = Config {
+        driving_pack: DrivingPack::SpringOnly,
+        uncoupled_test: Some(TestConfig {
+            min_margin: 1.5,
+            ..TestConfig::UNCOUPLED
+        }),
+        ..Config::default()
+    };
+    assert_eq!(
+        Monitor::new(bad).err(),
+        Some(ConfigError::OutOfRange {
+            parameter: "uncoupled_test.min_margin"
+        })
+    );
+    let mut m = Monitor::new(Config::default()).unwrap();
+    assert!(!m.request_functional_test(Procedure::Uncoupled));
+    assert!(m.functional_test().is_none());
+    assert!(m.request_functional_test(Procedure::Loaded));
 }

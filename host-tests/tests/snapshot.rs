@@ -64,7 +64,7 @@ fn the_fresh_state_is_the_one_recorded_with_the_record_magic() {
     bytes.iter().for_each(|b| d.push_byte(*b));
     assert_eq!(
         (MAGIC, bytes.len(), d.value()),
-        (*b"NBT5", 274, 0x64AE_005E),
+        (*b"NBT6", 274, 0x64AE_005E),
         "the record's magic, the fresh state's length and digest"
     );
 }

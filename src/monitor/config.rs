@@ -356,6 +356,9 @@ pub struct Config {
     pub commissioned: bool,
     /// The commanded functional test's procedure and pass floor.
     pub functional_test: TestConfig,
+    /// The test with the output uncoupled from the door, for a spring-only pack (set by
+    /// commissioning from its acceptance push; `None`: not run).
+    pub uncoupled_test: Option<TestConfig>,
 }
 
 /// Default rate of the fault-braking model (Hz): the cheapest-per-scene table's choice for
@@ -389,6 +392,7 @@ impl Config {
             braking_model_hz: DEFAULT_BRAKING_MODEL_HZ,
             commissioned: false,
             functional_test: TestConfig::DEFAULT,
+            uncoupled_test: None,
         }
     }
 }
@@ -437,6 +441,16 @@ pub enum ConfigError {
 }
 
 impl ConfigError {
+    /// The same error naming `parameter` instead.
+    pub const fn renamed(self, parameter: &'static str) -> ConfigError {
+        match self {
+            ConfigError::NotFinite { .. } => ConfigError::NotFinite { parameter },
+            ConfigError::OutOfRange { .. } => ConfigError::OutOfRange { parameter },
+            ConfigError::Overflow { .. } => ConfigError::Overflow { parameter },
+            ConfigError::Unstable { .. } => ConfigError::Unstable { parameter },
+        }
+    }
+
     /// The parameter the error names.
     pub const fn parameter(&self) -> &'static str {
         match self {

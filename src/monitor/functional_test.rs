@@ -85,6 +85,14 @@ impl TestConfig {
         torque_filter_hz: 50.0,
     };
 
+    /// The push with the output uncoupled from the door and a set 0.3 N·m applied along the
+    /// door's load (it gives the push its direction): a spring-only pack breaks away at
+    /// `C₀/(1 + g)`, with no door load to misjudge. Otherwise as [`TestConfig::DEFAULT`].
+    pub const UNCOUPLED: TestConfig = TestConfig {
+        load_nm: 0.3,
+        ..TestConfig::DEFAULT
+    };
+
     /// This procedure on a unit whose acceptance test under it opened at `opening_nm` and broke
     /// away at `breakaway_nm`: pass within [`COMMISSIONED_MIN_MARGIN`] …
     /// [`COMMISSIONED_MAX_MARGIN`] of that capacity.
@@ -156,10 +164,40 @@ struct Acceptance {
     load_error: Q16,
 }
 
+/// Which of the unit's procedures the crew runs.
+#[cfg_attr(
+    feature = "config-block",
+    derive(serde::Serialize, serde::Deserialize, Hash)
+)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Procedure {
+    /// Under the door's load (`Config::functional_test`): every pack.
+    Loaded,
+    /// The output uncoupled from the door (`Config::uncoupled_test`): a spring-only pack's
+    /// wear, which the door load's uncertainty hides in the loaded push.
+    Uncoupled,
+}
+
 impl TestSettings {
-    /// Checks the test's settings (`c.functional_test`) against the monitor's configuration.
+    /// Checks the loaded test's settings (`c.functional_test`) against the configuration.
     pub fn new(c: &Config) -> Result<TestSettings, ConfigError> {
-        let (m, t) = (&c.mechanism, &c.functional_test);
+        TestSettings::build(c, &c.functional_test)
+    }
+
+    /// The uncoupled test's (`c.uncoupled_test`), if set: a spring-only pack's only, judged
+    /// on its breakaway alone; errors name `uncoupled_test.*`.
+    pub fn uncoupled(c: &Config) -> Result<Option<TestSettings>, ConfigError> {
+        let Some(t) = &c.uncoupled_test else {
+            return Ok(None);
+        };
+        require(c.driving_pack == DrivingPack::SpringOnly, "uncoupled_test")?;
+        TestSettings::build(c, t)
+            .map(Some)
+            .map_err(|e| e.renamed(uncoupled_name(e.parameter())))
+    }
+
+    fn build(c: &Config, t: &TestConfig) -> Result<TestSettings, ConfigError> {
+        let m = &c.mechanism;
         let load = finite(t.load_nm, "functional_test.load_nm")?;
         require(load != 0.0, "functional_test.load_nm")?;
         let rate = positive(t.torque_rate_nm_s, "functional_test.torque_rate_nm_s")?;
@@ -243,6 +281,25 @@ impl TestSettings {
     }
 }
 
+/// A loaded-test parameter's name for the uncoupled test (shared ones unchanged).
+fn uncoupled_name(p: &'static str) -> &'static str {
+    match p {
+        "functional_test.load_nm" => "uncoupled_test.load_nm",
+        "functional_test.torque_rate_nm_s" => "uncoupled_test.torque_rate_nm_s",
+        "functional_test.max_torque_nm" => "uncoupled_test.max_torque_nm",
+        "functional_test.open_s" => "uncoupled_test.open_s",
+        "functional_test.settle_s" => "uncoupled_test.settle_s",
+        "functional_test.breakaway_rad" => "uncoupled_test.breakaway_rad",
+        "functional_test.expected_breakaway_nm" => "uncoupled_test.expected_breakaway_nm",
+        "functional_test.expected_opening_nm" => "uncoupled_test.expected_opening_nm",
+        "functional_test.min_margin" => "uncoupled_test.min_margin",
+        "functional_test.max_margin" => "uncoupled_test.max_margin",
+        "functional_test.load_tolerance" => "uncoupled_test.load_tolerance",
+        "functional_test.torque_filter_hz" => "uncoupled_test.torque_filter_hz",
+        shared => shared,
+    }
+}
+
 /// The monitor's tick rate, checked.
 fn tick_hz(c: &Config) -> Result<f64, ConfigError> {
     positive(c.tick_hz, "tick_hz")
@@ -273,6 +330,8 @@ pub enum TestResult {
 )]
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct TestReport {
+    /// The procedure run.
+    pub procedure: Procedure,
     /// Result.
     pub result: TestResult,
     /// Mean drive torque against the load over the opening's measured half (N·m).
@@ -307,14 +366,15 @@ pub struct FunctionalTest {
 }
 
 impl FunctionalTest {
-    /// A test just requested (its report `Running` with zeros until stepped).
-    pub fn new() -> FunctionalTest {
+    /// A test of `procedure` just requested (its report `Running` with zeros until stepped).
+    pub fn new(procedure: Procedure) -> FunctionalTest {
         FunctionalTest {
             ticks: 0,
             opening_sum: 0,
             rest_count: None,
             torque: Q16::ZERO,
             report: TestReport {
+                procedure,
                 result: TestResult::Running,
                 opening_torque_nm: Q16::ZERO,
                 load_nm: Q16::ZERO,
@@ -421,8 +481,9 @@ impl FunctionalTest {
     }
 }
 
-impl Default for FunctionalTest {
-    fn default() -> Self {
-        FunctionalTest::new()
+impl FunctionalTest {
+    /// The procedure requested.
+    pub fn procedure(&self) -> Procedure {
+        self.report.procedure
     }
 }

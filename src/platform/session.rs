@@ -1,13 +1,13 @@
 //! What every firmware image under QEMU shares, whatever its board: the semihosting
 //! arguments (`trace=FILE`, `bench`, `overrun-at=N`, `reset-every=N`, `trip-log=FILE`,
-//! `config=FILE`, `functional-test-at=N`), the trace it streams from the host, the boot self-check, the bench loop that
+//! `config=FILE`, `functional-test-at=N`, `uncoupled-test-at=N`), the trace it streams from the host, the boot self-check, the bench loop that
 //! counts instructions, and the log lines the xtask decodes (`cargo xtask run` parses them).
 
 use crate::app::{estimate_checksum, Ticker};
 use crate::board::SampleSource;
 use crate::digest::Fnv1a;
 use crate::event_log::{tick_time, Decimal, Event};
-use crate::monitor::functional_test::TestResult;
+use crate::monitor::functional_test::{Procedure, TestResult};
 use crate::monitor::{config_block, BrakeState, Config, Monitor, Scene};
 use crate::platform::{self, meter::Meter, stack};
 use crate::replay::{self, Feeder, StreamRing, Streamed, FEED_CHUNK, HEADER_BYTES, RECORD_BYTES};
@@ -29,6 +29,8 @@ pub struct Args {
     pub reset_every: u32,
     /// The tick at which the ground crew requests the functional test (`u32::MAX`: never).
     pub functional_test_at: u32,
+    /// Which (`uncoupled-test-at=N` asks for the uncoupled push).
+    pub functional_test: Procedure,
     path: [u8; PATH_BYTES + 1],
     trip_path: [u8; PATH_BYTES + 1],
     config_path: [u8; PATH_BYTES + 1],
@@ -50,6 +52,7 @@ pub fn args() -> Args {
         overrun_at: u32::MAX,
         reset_every: 0,
         functional_test_at: u32::MAX,
+        functional_test: Procedure::Loaded,
         path: [0; PATH_BYTES + 1],
         trip_path: [0; PATH_BYTES + 1],
         config_path: [0; PATH_BYTES + 1],
@@ -79,6 +82,10 @@ pub fn args() -> Args {
                 a.reset_every = n.parse().unwrap_or(0);
             } else if let Some(n) = arg.strip_prefix("functional-test-at=") {
                 a.functional_test_at = n.parse().unwrap_or(u32::MAX);
+                a.functional_test = Procedure::Loaded;
+            } else if let Some(n) = arg.strip_prefix("uncoupled-test-at=") {
+                a.functional_test_at = n.parse().unwrap_or(u32::MAX);
+                a.functional_test = Procedure::Uncoupled;
             }
         }
     }
@@ -309,8 +316,13 @@ pub fn finish<P: embedded_hal::digital::OutputPin>(
             Decimal::from_q16(r.capacity_nm.to_bits(), 1000),
         );
         let m = Decimal::from_q16(r.margin.to_bits(), 1000);
+        let procedure = match r.procedure {
+            Procedure::Loaded => defmt::intern!("loaded"),
+            Procedure::Uncoupled => defmt::intern!("uncoupled"),
+        };
         defmt::info!(
-            "functional-test result={=istr} opening_nm={=str}{=u32}.{=u32:03} breakaway_nm={=str}{=u32}.{=u32:03} capacity_nm={=str}{=u32}.{=u32:03} margin={=str}{=u32}.{=u32:03}",
+            "functional-test procedure={=istr} result={=istr} opening_nm={=str}{=u32}.{=u32:03} breakaway_nm={=str}{=u32}.{=u32:03} capacity_nm={=str}{=u32}.{=u32:03} margin={=str}{=u32}.{=u32:03}",
+            procedure,
             result,
             o.sign(), o.whole, o.frac,
             b.sign(), b.whole, b.frac,

@@ -4,6 +4,8 @@
 
 use crate::replay::trace_of;
 use host_tests::dormant::{accept, procedure_of};
+use noback::monitor::functional_test::Procedure;
+use noback::monitor::DrivingPack;
 use noback_twin::args::bad_input;
 use noback_twin::scene::SceneKind;
 use noback_twin::trace::Trace;
@@ -16,8 +18,9 @@ pub struct CommissionArgs {
     /// The acceptance runs, each a built-in scene, a TOML scene file or a recorded trace
     /// (`.csv`): the drive opens against (or closes with) a known load, is cut, and the brake
     /// holds; two openings at loads 5 N·m or more apart also give the current's gain, two
-    /// closings so the overrunning line (docs/commissioning.md). A
-    /// `functional_test` scene among them sets the functional test's expected breakaway.
+    /// closings so the overrunning line (docs/commissioning.md). A `functional_test` scene
+    /// among them sets the functional test's expected breakaway; one at 1 N·m or less, a
+    /// spring-only pack's uncoupled push.
     #[arg(value_name = "SCENE|FILE|TRACE.csv", required = true)]
     pub targets: Vec<String>,
     /// The load the crew applied in each run, in order (N·m); a scene's own load when not given,
@@ -45,12 +48,12 @@ pub fn main(a: &CommissionArgs) -> Result<i32, String> {
         ));
     }
     let mut runs = Vec::new();
-    // The unit's functional test at acceptance: (trace, its scene), set after the rest.
-    let mut test_run = None;
+    // The unit's functional tests at acceptance: (trace, its scene), set after the rest.
+    let mut test_runs = Vec::new();
     for (i, target) in a.targets.iter().enumerate() {
         let (trace, scene_load) = match trace_of(target) {
             Ok((trace, Some(scene))) if scene.kind == SceneKind::FunctionalTest => {
-                test_run = Some((trace, scene));
+                test_runs.push((trace, scene));
                 continue;
             }
             Ok((trace, scene)) => (trace, scene.map(|s| s.load_torque_nm)),
@@ -73,12 +76,28 @@ pub fn main(a: &CommissionArgs) -> Result<i32, String> {
         Err(e) => return Ok(bad_input("commission", &e)),
     };
     let mut test_note = String::new();
-    if let Some((trace, scene)) = &test_run {
-        let procedure = procedure_of(scene);
-        let Some(mut t) = accept(trace, c.config, &procedure, scene.test.start_s)? else {
+    let mut kinds = Vec::new();
+    for (trace, scene) in &test_runs {
+        let (kind, procedure) = procedure_of(scene);
+        if kinds.contains(&kind) {
             return Ok(bad_input(
                 "commission",
-                "the acceptance functional test did not pass: the unit is not healthy",
+                &format!("two {kind:?} functional tests given: one of each at most"),
+            ));
+        }
+        kinds.push(kind);
+        if kind == Procedure::Uncoupled && c.config.driving_pack != DrivingPack::SpringOnly {
+            return Ok(bad_input(
+                "commission",
+                "the uncoupled push is for a spring-only pack; these runs identified a relieved one",
+            ));
+        }
+        let Some(mut t) = accept(trace, c.config, (kind, &procedure), scene.test.start_s)? else {
+            return Ok(bad_input(
+                "commission",
+                &format!(
+                    "the acceptance functional test ({kind:?}) did not pass: the unit is not healthy"
+                ),
             ));
         };
         // The file carries the acceptance readings to the millinewton-metre.
@@ -89,9 +108,13 @@ pub fn main(a: &CommissionArgs) -> Result<i32, String> {
             t.expected_breakaway_nm.unwrap_or(0.0),
             t.expected_opening_nm.unwrap_or(0.0),
         );
-        c.config.functional_test = t;
-        test_note = format!(
-            ", functional test breakaway {b} N·m, opening {o} N·m at {} N·m",
+        match kind {
+            Procedure::Loaded => c.config.functional_test = t,
+            Procedure::Uncoupled => c.config.uncoupled_test = Some(t),
+        }
+        test_note += &format!(
+            ", {} functional test breakaway {b} N·m, opening {o} N·m at {} N·m",
+            format!("{kind:?}").to_lowercase(),
             procedure.load_nm
         );
     }

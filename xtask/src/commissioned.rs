@@ -3,6 +3,9 @@
 
 use crate::cores::Core;
 use crate::run;
+use host_tests::dormant::accept;
+use noback::monitor::functional_test::{Procedure, TestConfig};
+use noback::monitor::{Config, DrivingPack};
 
 /// The paper reading's reverse_load commissioned from itself (a spring-only pack, another
 /// form than the defaults'), its configuration handed to the firmware as a block: the firmware
@@ -10,24 +13,15 @@ use crate::run;
 /// whose estimates differ from the uncommissioned ones (on the STM32F405 the block sits in its
 /// configuration sector, as commissioning writes it).
 pub fn block_is_bit_exact(core: Core) -> Result<(), String> {
-    let dir = crate::shell::workspace_root().join("target").join("replay");
-    std::fs::create_dir_all(&dir).map_err(|e| e.to_string())?;
-    let scene = dir.join("paper_reverse_load.toml");
-    std::fs::write(
-        &scene,
+    let scene = scene_file(
+        "paper_reverse_load",
         "[scene]\nkind = \"reverse_load\"\nreading = \"paper\"\n",
-    )
-    .map_err(|e| e.to_string())?;
-    let scene = scene.to_string_lossy().into_owned();
+    )?;
     let trace = crate::replay::twin_trace(&scene)?;
     let c = host_tests::commission::commission(&[(&trace, 20.3)])?;
     let (report, ok) = run::replay_report_with(&scene, core, None, None, false, Some(c.config))?;
-    let uncommissioned = crate::replay::host_run(
-        &crate::replay::nbr1(&trace)?,
-        &[],
-        None,
-        noback::monitor::Config::default(),
-    )?;
+    let uncommissioned =
+        crate::replay::host_run(&crate::replay::nbr1(&trace)?, &[], None, Config::default())?;
     let other = format!("{:#010x}", uncommissioned.totals.digest);
     println!(
         "configuration {} ({:?}), bit_exact {}, firmware digest {} (uncommissioned {other})",
@@ -47,26 +41,64 @@ pub fn block_is_bit_exact(core: Core) -> Result<(), String> {
 /// a healthy unit commissioned on its own acceptance test passes, the same unit with its spring
 /// half gone fails (docs/functional-test.md).
 pub fn functional_test_on_firmware() -> Result<(), String> {
-    let dir = crate::shell::workspace_root().join("target").join("replay");
-    std::fs::create_dir_all(&dir).map_err(|e| e.to_string())?;
     let opening = crate::replay::twin_trace("reverse_load")?;
     let test = crate::replay::twin_trace("functional_test")?;
     let mut c = host_tests::commission::commission(&[(&opening, 20.3)])?.config;
     let start = noback_twin::scene::DEFAULT_TEST.start_s;
-    c.functional_test = host_tests::dormant::accept(&test, c, &c.functional_test, start)?
+    c.functional_test = accept(&test, c, (Procedure::Loaded, &c.functional_test), start)?
         .ok_or("the healthy unit did not pass its acceptance test")?;
-    let spring = dir.join("functional_test_spring_half.toml");
-    std::fs::write(
-        &spring,
+    let spring = scene_file(
+        "functional_test_spring_half",
         "[scene]\nkind = \"functional_test\"\n[[fault]]\nkind = \"spring_broken\"\nat_s = 0.0\nseverity = 0.5\n",
-    )
-    .map_err(|e| e.to_string())?;
+    )?;
+    pass_then_fail(&["functional_test".to_string(), spring], c)
+}
+
+/// The uncoupled push under QEMU: a paper-form unit, commissioned as a spring-only pack with
+/// its acceptance push uncoupled, passes healthy and fails with its pack worn by half.
+pub fn uncoupled_test_on_firmware() -> Result<(), String> {
+    let paper = "[scene]\nreading = \"paper\"\n";
+    let opening = scene_file(
+        "paper_reverse_load",
+        &format!("{paper}kind = \"reverse_load\"\n"),
+    )?;
+    let test = format!("{paper}kind = \"functional_test\"\nload_torque_nm = 0.3\n");
+    let healthy = scene_file("paper_uncoupled_test", &test)?;
+    let worn = scene_file(
+        "paper_uncoupled_test_worn",
+        &format!("{test}[[fault]]\nkind = \"pack_wear\"\nat_s = 0.0\nseverity = 0.5\n"),
+    )?;
+    let mut c =
+        host_tests::commission::commission(&[(&crate::replay::twin_trace(&opening)?, 20.3)])?
+            .config;
+    if c.driving_pack != DrivingPack::SpringOnly {
+        return Err("the paper-form unit was not commissioned as a spring-only pack".into());
+    }
+    let start = noback_twin::scene::DEFAULT_TEST.start_s;
+    let uncoupled = TestConfig::UNCOUPLED;
+    let trace = crate::replay::twin_trace(&healthy)?;
+    c.uncoupled_test = Some(
+        accept(&trace, c, (Procedure::Uncoupled, &uncoupled), start)?
+            .ok_or("the healthy unit's uncoupled push did not break away")?,
+    );
+    pass_then_fail(&[healthy, worn], c)
+}
+
+/// A scene file in target/replay; returns its path.
+fn scene_file(stem: &str, text: &str) -> Result<String, String> {
+    let dir = crate::shell::workspace_root().join("target").join("replay");
+    std::fs::create_dir_all(&dir).map_err(|e| e.to_string())?;
+    let path = dir.join(format!("{stem}.toml"));
+    std::fs::write(&path, text).map_err(|e| e.to_string())?;
+    Ok(path.to_string_lossy().into_owned())
+}
+
+/// Runs `scenes` on the M3 firmware with `config`; the first must pass, the second fail.
+fn pass_then_fail(scenes: &[String], config: Config) -> Result<(), String> {
     let mut verdicts = Vec::new();
-    for scene in [
-        "functional_test".to_string(),
-        spring.to_string_lossy().into_owned(),
-    ] {
-        let (report, ok) = run::replay_report_with(&scene, Core::M3, None, None, false, Some(c))?;
+    for scene in scenes {
+        let (report, ok) =
+            run::replay_report_with(scene, Core::M3, None, None, false, Some(config))?;
         println!("{scene}: {}", report["functional_test"]);
         if !ok {
             return Err(format!(

@@ -12,6 +12,7 @@ use host_tests::accuracy::{
     scene_trace, Accuracy, COMPARE_WINDOW_S,
 };
 use host_tests::mc::not_driven;
+use noback::monitor::functional_test::Procedure;
 use noback::monitor::Config;
 use noback::sensors::SensorConfig;
 use noback_twin::fault::Fault;
@@ -56,17 +57,18 @@ pub fn config_from_file(path: &std::path::Path) -> Result<Config, String> {
 /// configuration file's procedure (a commissioned unit's acceptance readings), or the scene's.
 fn functional_test_json(
     trace: &noback_twin::trace::Trace,
-    config: Config,
-    from_file: bool,
+    config: Option<Config>,
     scene: &Scene,
 ) -> Result<serde_json::Value, String> {
-    let test = if from_file {
-        config.functional_test
-    } else {
-        host_tests::dormant::procedure_of(scene)
+    let (kind, test) = host_tests::dormant::procedure_of(scene);
+    let (config, kind) = crate::run::test_configuration(config, kind, test)?;
+    let test = match kind {
+        Procedure::Loaded => config.functional_test,
+        Procedure::Uncoupled => config.uncoupled_test.unwrap_or(test),
     };
-    let r = run_functional_test(trace, config, &test, scene.test.start_s)?;
+    let r = run_functional_test(trace, config, (kind, &test), scene.test.start_s)?;
     Ok(json!({
+        "procedure": format!("{:?}", r.procedure).to_lowercase(),
         "result": format!("{:?}", r.result).to_lowercase(),
         "opening_torque_nm": r.opening_torque_nm.to_num::<f64>(),
         "breakaway_torque_nm": r.breakaway_torque_nm.to_num::<f64>(),
@@ -111,7 +113,13 @@ pub fn main(a: &MonitorArgs) -> Result<i32, String> {
         .as_ref()
         .filter(|s| s.kind == SceneKind::FunctionalTest)
     {
-        Some(s) => Some(functional_test_json(&trace, config, a.config.is_some(), s)?),
+        Some(s) => {
+            let file = a.config.is_some().then_some(config);
+            match functional_test_json(&trace, file, s) {
+                Ok(v) => Some(v),
+                Err(e) => return Ok(bad_input("monitor", &e)),
+            }
+        }
         None => None,
     };
 

@@ -16,7 +16,7 @@ pub fn trace_of(target: &str) -> Result<(Trace, Option<noback_twin::scene::Scene
     Ok((host_tests::accuracy::scene_trace(&scene)?, Some(scene)))
 }
 use noback::app::{Ticker, Totals};
-use noback::monitor::functional_test::TestReport;
+use noback::monitor::functional_test::{Procedure, TestReport};
 use noback::monitor::{Config, Estimate, Inputs, Monitor};
 use noback::replay::{encode_header, encode_record, Replay};
 use noback_twin::trace::Trace;
@@ -111,19 +111,19 @@ pub fn host_run(
 }
 
 /// [`host_run`] with the crew's functional-test request before tick `test_at`, as the
-/// firmware's `functional-test-at=N`.
+/// firmware's `functional-test-at=N` (`uncoupled-test-at=N`).
 pub fn host_run_tested(
     bytes: &[u8],
     overruns: &[(u32, u32)],
     reset_every: Option<u32>,
     config: Config,
-    test_at: Option<u32>,
+    test_at: Option<(u32, Procedure)>,
 ) -> Result<HostRun, String> {
     let replay = Replay::parse(bytes).map_err(|e| format!("replay: {e:?}"))?;
     let monitor = Monitor::new(config).map_err(|e| format!("monitor: {e:?}"))?;
     let mut ticker: Ticker<_, _> = Ticker::new(monitor, replay, HostPin::default());
-    if let Some(at) = test_at {
-        ticker.request_functional_test_at(at);
+    if let Some((at, kind)) = test_at {
+        ticker.request_functional_test_at(at, kind);
     }
     let mut estimates = Vec::new();
     loop {

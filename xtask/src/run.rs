@@ -13,7 +13,7 @@ use crate::replay::{host_run, host_run_tested, nbr1, stress_trace, twin_trace, S
 use crate::shell::workspace_root;
 use crate::{bootstrap, elf_size};
 use noback::monitor::config_block::{self, CONFIG_BLOCK_BYTES};
-use noback::monitor::functional_test::TestConfig;
+use noback::monitor::functional_test::{Procedure, TestConfig};
 use noback::monitor::Config;
 use noback_twin::scene::SceneKind;
 use serde_json::json;
@@ -98,6 +98,11 @@ pub fn main(a: &RunArgs) -> Result<i32, String> {
             Err(e) => return Ok(noback_twin::args::bad_input("run", &e)),
         },
     };
+    if let Some((kind, test, _)) = functional_test_of(&a.scene) {
+        if let Err(e) = test_configuration(config, kind, test) {
+            return Ok(noback_twin::args::bad_input("run", &e));
+        }
+    }
     let (report, ok) =
         match replay_report_with(&a.scene, core, a.overrun_at, reset_every, !a.json, config) {
             // The twin failing on a scene that passed the schema is still the scene's fault.
@@ -114,12 +119,38 @@ pub fn main(a: &RunArgs) -> Result<i32, String> {
     Ok(if ok { 0 } else { 1 })
 }
 
-/// The functional test a scene asks for (its procedure, and when the crew requests it), if it
-/// is a `functional_test` scene.
-fn functional_test_of(scene: &str) -> Option<(TestConfig, f64)> {
+/// The functional test a scene asks for (which, its procedure, and when the crew requests
+/// it), if it is a `functional_test` scene.
+fn functional_test_of(scene: &str) -> Option<(Procedure, TestConfig, f64)> {
     let s = noback_twin::cli::load_scene(scene, None).ok()?;
-    (s.kind == SceneKind::FunctionalTest)
-        .then(|| (host_tests::dormant::procedure_of(&s), s.test.start_s))
+    (s.kind == SceneKind::FunctionalTest).then(|| {
+        let (kind, test) = host_tests::dormant::procedure_of(&s);
+        (kind, test, s.test.start_s)
+    })
+}
+
+/// The configuration and the procedure a test scene runs on: a configuration file's procedure
+/// stands (a commissioned unit's acceptance readings); without one, the loaded procedure as the
+/// scene sets it (the uncommissioned monitor has no uncoupled push).
+pub fn test_configuration(
+    config: Option<Config>,
+    kind: Procedure,
+    test: TestConfig,
+) -> Result<(Config, Procedure), String> {
+    match config {
+        Some(c) if kind == Procedure::Uncoupled && c.uncoupled_test.is_none() => Err(format!(
+            "a functional_test scene at {} N·m is the uncoupled push; the configuration has none (commission the unit with one)",
+            test.load_nm
+        )),
+        Some(c) => Ok((c, kind)),
+        None => Ok((
+            Config {
+                functional_test: test,
+                ..Config::default()
+            },
+            Procedure::Loaded,
+        )),
+    }
 }
 
 /// Runs a scene through the firmware under QEMU and the host; returns the summary and whether
@@ -152,19 +183,12 @@ pub fn replay_report_with(
         }
         twin_trace(scene)?
     };
-    // A functional-test scene: the crew requests the test when its ramp starts; without a
-    // configuration file the procedure (load, ramp) is configured as the scene sets it.
+    // A functional-test scene: the crew requests the test when its ramp starts.
     let (config, test_at) = match functional_test_of(scene) {
-        // A configuration file's procedure stands (a commissioned unit's expected breakaway).
-        Some((test, start_s)) => {
-            let c = config.unwrap_or(Config {
-                functional_test: test,
-                ..Config::default()
-            });
-            (
-                Some(c),
-                Some((start_s * trace.sample_rate_hz).round() as u32),
-            )
+        Some((kind, test, start_s)) => {
+            let (c, kind) = test_configuration(config, kind, test)?;
+            let at = (start_s * trace.sample_rate_hz).round() as u32;
+            (Some(c), Some((at, kind)))
         }
         None => (config, None),
     };
@@ -213,8 +237,10 @@ pub fn replay_report_with(
     if let Some(n) = reset_every {
         rt_args.push(format!("reset-every={n}"));
     }
-    if let Some(n) = test_at {
-        rt_args.push(format!("functional-test-at={n}"));
+    match test_at {
+        Some((n, Procedure::Loaded)) => rt_args.push(format!("functional-test-at={n}")),
+        Some((n, Procedure::Uncoupled)) => rt_args.push(format!("uncoupled-test-at={n}")),
+        None => {}
     }
     // The board's GPIO is read back from QEMU's log of its (unmodelled) registers.
     let gpio_log = dir.join(format!("{stem}-{}-gpio.log", core.name()));
@@ -330,7 +356,7 @@ pub fn replay_report_with(
     // The trip log read back: on a run without operator resets, one record per flag change.
     let (trip_log, trips_ok) = if records_trips {
         let bytes = std::fs::read(&region).map_err(|e| format!("{}: {e}", region.display()))?;
-        let (mut v, _) = crate::trip_log::report(bytes, &flags)?;
+        let (mut v, _) = crate::trip_log::report(bytes, &flags, config)?;
         let exact = v["replay_bit_exact"] == true;
         let ok = exact && (v["matches_flags"] == true || reset_every.is_some());
         let line = line_with(&realtime.lines, "trip-log")?;
@@ -346,8 +372,10 @@ pub fn replay_report_with(
         Some(h) => {
             let line = line_with(&realtime.lines, "functional-test")?;
             let result: String = field(&line, "result")?;
+            let procedure: String = field(&line, "procedure")?;
             let num = |k: &str| field::<f64>(&line, k);
             let v = json!({
+                "procedure": procedure,
                 "result": result,
                 "opening_torque_nm": num("opening_nm")?,
                 "breakaway_torque_nm": num("breakaway_nm")?,
@@ -356,6 +384,7 @@ pub fn replay_report_with(
             });
             let milli = |q: noback::fx::Q16| (q.to_num::<f64>() * 1e3).round() / 1e3;
             let same = result == format!("{:?}", h.result).to_lowercase()
+                && procedure == format!("{:?}", h.procedure).to_lowercase()
                 && (num("opening_nm")? - milli(h.opening_torque_nm)).abs() < 1.5e-3
                 && (num("breakaway_nm")? - milli(h.breakaway_torque_nm)).abs() < 1.5e-3
                 && (num("margin")? - milli(h.margin)).abs() < 1.5e-3;

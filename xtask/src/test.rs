@@ -149,6 +149,8 @@ pub fn main(a: &TestArgs) -> Result<i32, String> {
             crate::commissioned::block_is_bit_exact(Core::M3)?;
             section("the functional test on the firmware: a healthy unit passes, half a spring fails (m3)");
             crate::commissioned::functional_test_on_firmware()?;
+            section("the uncoupled push on the firmware: a spring-only unit passes, its pack worn by half fails (m3)");
+            crate::commissioned::uncoupled_test_on_firmware()?;
         }
         let fw_digest = u32::from_str_radix(
             report["fx_selfcheck_digest"]
@@ -346,7 +348,7 @@ fn trip_log_holds() -> Result<(), String> {
     let (records, _) = crate::trip_log::record_scene(&fault_scene()?)?;
     let mut all = code == 0 && !records.is_empty();
     for bytes in &records {
-        let (same, line) = crate::trip_log::replay(bytes)?;
+        let (same, line) = crate::trip_log::replay(bytes, noback::monitor::Config::default())?;
         println!("{line}");
         all &= same;
     }

@@ -103,22 +103,25 @@ pub fn main(a: &LogArgs) -> Result<i32, String> {
                     ),
                 ));
             };
-            let (same, line) = replay(bytes)?;
+            let (same, line) = replay(bytes, Config::default())?;
             println!("{line}");
             Ok(if same { 0 } else { 1 })
         }
     }
 }
 
-/// Replays one record; returns whether it reproduced its estimate and a line saying so.
-pub fn replay(bytes: &[u8]) -> Result<(bool, String), String> {
+/// Replays one record on `config` (the one the unit ran); returns whether it reproduced its
+/// estimate and a line saying so.
+pub fn replay(bytes: &[u8], config: Config) -> Result<(bool, String), String> {
     let r = decode(bytes).map_err(|e| format!("record: {e:?}"))?;
-    let config = Config::default();
     let digest = Monitor::new(config)
         .map_err(|e| format!("{e:?}"))?
         .settings_digest();
     if digest != r.config_digest {
-        return Err(format!("the record's configuration digest {:#010x} is not the default configuration's {digest:#010x}", r.config_digest));
+        return Err(format!(
+            "the record's configuration digest {:#010x} is not this configuration's {digest:#010x}",
+            r.config_digest
+        ));
     }
     let last = r.replay(config).map_err(|e| format!("replay: {e:?}"))?;
     let same = last.to_words() == r.estimate && last.flags == r.now && last.tick == r.tick;
@@ -195,17 +198,19 @@ fn read_pages<const PAGE: usize>(bytes: Vec<u8>) -> Result<Vec<Vec<u8>>, String>
 }
 
 /// The `trip_log` of a run's report: each record's tick, the flags it raised and whether it
-/// replays bit-exact; and whether the raisings equal `flags` (`[{flag, tick}]`).
+/// replays bit-exact on the run's `config`; and whether the raisings equal `flags`
+/// (`[{flag, tick}]`).
 pub fn report(
     region: Vec<u8>,
     flags: &[serde_json::Value],
+    config: Config,
 ) -> Result<(serde_json::Value, bool), String> {
     let mut entries = Vec::new();
     let mut raised = Vec::new();
     let mut all_exact = true;
     for bytes in read_region(region)? {
         let r = decode(&bytes).map_err(|e| format!("trip record: {e:?}"))?;
-        let (exact, _) = replay(&bytes)?;
+        let (exact, _) = replay(&bytes, config)?;
         all_exact &= exact;
         let new = Flags::from_bits(r.now.bits() & !r.before.bits());
         for name in crate::run::flag_names(new.bits()) {
