@@ -225,10 +225,7 @@ impl Monitor {
     /// ground crew's request; the drive runs its ramp). A test already run is started afresh.
     /// `false` (nothing started) if the configuration has no such procedure.
     pub fn request_functional_test(&mut self, procedure: Procedure) -> bool {
-        let configured = match procedure {
-            Procedure::Loaded => true,
-            Procedure::Uncoupled => self.settings.uncoupled_test.is_some(),
-        };
+        let configured = self.settings.functional_test.judge(procedure).is_some();
         if configured {
             self.state.test = Some(FunctionalTest::new(procedure));
         }
@@ -382,12 +379,12 @@ impl Monitor {
         (st.gave_way, st.reading_switch) = (gave_way, reading_switch);
         st.latch(raised.union(fast));
         if let Some(test) = st.test.as_mut() {
-            let settings = match test.procedure() {
-                Procedure::Loaded => Some(&k.functional_test),
-                Procedure::Uncoupled => k.uncoupled_test.as_ref(),
-            };
-            if let Some(s) = settings {
-                test.step(s, x, o.drive_torque, st.flags);
+            match k.functional_test.judge(test.procedure()) {
+                Some(j) => {
+                    test.step(&k.functional_test, j, x, o.drive_torque, st.flags);
+                }
+                // A state restored onto a configuration without this procedure.
+                None => test.abort(),
             }
         }
     }

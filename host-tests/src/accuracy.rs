@@ -91,7 +91,7 @@ pub fn run_functional_test(
     let start = (start_s * trace.sample_rate_hz).round() as usize;
     for (i, r) in trace.rows.iter().enumerate() {
         if i == start && !monitor.request_functional_test(kind) {
-            return Err(format!("no {kind:?} functional test configured"));
+            return Err(format!("no {kind:?} functional test configured").to_lowercase());
         }
         monitor.step(&Inputs::new(
             r.current_code,

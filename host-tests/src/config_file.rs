@@ -19,7 +19,7 @@
 //! expected_opening_nm = 24.8     # and its opening torque (needs the breakaway)
 //! min_margin = 0.95
 //! [monitor.uncoupled_test]       # a spring-only pack's push with the output uncoupled (its
-//! expected_breakaway_nm = 8.2    # fields as above, over `TestConfig::UNCOUPLED`; absent: none)
+//! expected_breakaway_nm = 8.2    # fields as above; its drive and timing are the loaded test's)
 //! [monitor.aiding_braking]       # a spring-only pack's braking (AidingBraking), all three
 //! inertia_kg_m2 = 0.15
 //! drag_nm = 8.4
@@ -181,7 +181,8 @@ pub fn parse(text: &str) -> Result<Config, String> {
     }
     if let Some(t) = m.remove("uncoupled_test") {
         let path = "monitor.uncoupled_test";
-        c.uncoupled_test = Some(test_table(table(t, path)?, TestConfig::UNCOUPLED, path)?);
+        let base = c.functional_test.uncoupled_beside();
+        c.uncoupled_test = Some(test_table(table(t, path)?, base, path)?);
     }
     if let Some(t) = m.remove("aiding_braking") {
         let path = "monitor.aiding_braking";
@@ -290,7 +291,7 @@ pub fn write(c: &Config, comment: &str) -> Result<String, String> {
     }
     if let Some(t) = c.uncoupled_test {
         out.push_str("[monitor.uncoupled_test]\n");
-        out.push_str(&test_lines(TestConfig::UNCOUPLED, t));
+        out.push_str(&test_lines(c.functional_test.uncoupled_beside(), t));
     }
     if let Some(a) = c.aiding_braking {
         out.push_str(&format!(

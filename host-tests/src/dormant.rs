@@ -58,10 +58,9 @@ pub fn procedure_of(scene: &Scene) -> (Procedure, TestConfig) {
     (procedure, test)
 }
 
-/// The acceptance test: `procedure` run on a healthy unit's `trace` (requested at `start_s`);
-/// the procedure commissioned on its breakaway and opening torques if the unit passed against
-/// the design (the loaded push) or broke away at all (the uncoupled push, which the design does
-/// not predict: docs/functional-test.md), else `None`.
+/// The acceptance test on a healthy unit's `trace`: the procedure commissioned on its readings
+/// if the unit passed against the design (loaded) or broke away at all (uncoupled, which the
+/// design does not predict: docs/functional-test.md), else `None`.
 pub fn accept(
     trace: &Trace,
     config: Config,
@@ -141,9 +140,10 @@ pub fn functional_test_after(d: &Draw, config: Config) -> Result<Verdict, String
         in_service.noise.seed = rng.next_u64();
         let trace = scene_trace(&in_service)?;
         let test = match kind {
-            Procedure::Loaded => unit.functional_test,
-            Procedure::Uncoupled => unit.uncoupled_test.unwrap_or(*procedure),
-        };
+            Procedure::Loaded => Some(unit.functional_test),
+            Procedure::Uncoupled => unit.uncoupled_test,
+        }
+        .ok_or("the uncoupled push was not accepted")?;
         if run_functional_test(&trace, unit, (*kind, &test), start)?.result != TestResult::Pass {
             return Ok(Verdict::Fail);
         }

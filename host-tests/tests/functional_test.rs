@@ -302,8 +302,9 @@ fn the_uncoupled_push_finds_a_worn_spring_only_pack() {
     }
 }
 
-/// The uncoupled push is a spring-only pack's: configured on a relieved one it is refused, and
-/// requested where none is configured nothing starts.
+/// The uncoupled push is a spring-only pack's, on the loaded push's drive: configured on a
+/// relieved pack or with another drive it is refused, and requested where none is configured
+/// nothing starts.
 #[test]
 fn the_uncoupled_push_needs_a_spring_only_unit() {
     let relieved = Config {
@@ -328,6 +329,19 @@ fn the_uncoupled_push_needs_a_spring_only_unit() {
         Monitor::new(bad).err(),
         Some(ConfigError::OutOfRange {
             parameter: "uncoupled_test.min_margin"
+        })
+    );
+    let other_drive = Config {
+        uncoupled_test: Some(TestConfig {
+            open_s: 0.4,
+            ..TestConfig::UNCOUPLED
+        }),
+        ..bad
+    };
+    assert_eq!(
+        Monitor::new(other_drive).err(),
+        Some(ConfigError::OutOfRange {
+            parameter: "uncoupled_test.open_s"
         })
     );
     let mut m = Monitor::new(Config::default()).unwrap();

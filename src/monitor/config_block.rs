@@ -4,7 +4,7 @@
 //!
 //! | bytes | what |
 //! |---|---|
-//! | 4 | magic `NBCF` (a later layout of the settings changes it) |
+//! | 4 | magic `NBCE` (a later layout of the settings changes it) |
 //! | n | the monitor's settings (`Settings::new` of the `Config`), postcard |
 //! | 4 | CRC-32/ISCSI of the settings' bytes, little-endian (postcard's `use-crc` flavour) |
 //!
@@ -16,7 +16,7 @@ use super::{Config, ConfigError, Monitor};
 use crc::{Crc, CRC_32_ISCSI};
 
 /// The block's first bytes.
-pub const CONFIG_BLOCK_MAGIC: [u8; 4] = *b"NBCF";
+pub const CONFIG_BLOCK_MAGIC: [u8; 4] = *b"NBCE";
 /// Room the firmware keeps for a block (the default settings' block takes 320 bytes).
 pub const CONFIG_BLOCK_BYTES: usize = 1024;
 
@@ -116,7 +116,7 @@ mod tests {
         let crc = u32::from_le_bytes(buf[n - 4..n].try_into().unwrap());
         assert_eq!(
             (n, crc),
-            (321, 0xC6EB_87A3),
+            (320, 0x2241_D3B6),
             "length and CRC of the default block"
         );
     }

@@ -86,12 +86,26 @@ impl TestConfig {
     };
 
     /// The push with the output uncoupled from the door and a set 0.3 N·m applied along the
-    /// door's load (it gives the push its direction): a spring-only pack breaks away at
-    /// `C₀/(1 + g)`, with no door load to misjudge. Otherwise as [`TestConfig::DEFAULT`].
+    /// door's load (it gives the push its direction): a spring-only pack's clamp alone, with no
+    /// door load to misjudge. Otherwise as [`TestConfig::DEFAULT`].
     pub const UNCOUPLED: TestConfig = TestConfig {
         load_nm: 0.3,
         ..TestConfig::DEFAULT
     };
+
+    /// The uncoupled push on this procedure's drive and timing (what `TestSettings::uncoupled`
+    /// requires): [`TestConfig::UNCOUPLED`]'s load on this one's side, its band, no readings.
+    pub fn uncoupled_beside(self) -> TestConfig {
+        TestConfig {
+            load_nm: TestConfig::UNCOUPLED.load_nm.copysign(self.load_nm),
+            expected_breakaway_nm: None,
+            expected_opening_nm: None,
+            min_margin: TestConfig::UNCOUPLED.min_margin,
+            max_margin: TestConfig::UNCOUPLED.max_margin,
+            load_tolerance: TestConfig::UNCOUPLED.load_tolerance,
+            ..self
+        }
+    }
 
     /// This procedure on a unit whose acceptance test under it opened at `opening_nm` and broke
     /// away at `breakaway_nm`: pass within [`COMMISSIONED_MIN_MARGIN`] …
@@ -126,15 +140,10 @@ pub const COMMISSIONED_MAX_MARGIN: f64 = 1.05;
 )]
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct TestSettings {
-    sign: i32,
-    load: Q16,
-    /// `1 + g`.
-    lever: Q16,
-    expected_capacity: Q16,
-    min_capacity: Q16,
-    max_capacity: Q16,
-    /// The acceptance test's readings and their weights, when commissioned on both.
-    acceptance: Option<Acceptance>,
+    /// The loaded push's load and band.
+    judge: TestJudge,
+    /// A relieved pack's acceptance readings, or a spring-only pack's uncoupled push.
+    companion: Companion,
     /// Ticks from the request: the opening's measured half starts, the opening ends, the push
     /// starts.
     measure_from: u32,
@@ -145,6 +154,38 @@ pub struct TestSettings {
     breakaway_counts: i32,
     out_bits: u8,
     alpha: Gain,
+}
+
+/// What a push is judged by: its load's sign and size, `1 + g`, the expected capacity and its
+/// band. The uncoupled push keeps only this, and runs the loaded push's drive and timing.
+#[cfg_attr(
+    feature = "config-block",
+    derive(serde::Serialize, serde::Deserialize, Hash)
+)]
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct TestJudge {
+    sign: i32,
+    load: Q16,
+    lever: Q16,
+    expected_capacity: Q16,
+    min_capacity: Q16,
+    max_capacity: Q16,
+}
+
+/// What the loaded push carries beside its judge; never both (a relieved pack has no uncoupled
+/// push, a spring-only pack no opening reading), so they share the room.
+#[cfg_attr(
+    feature = "config-block",
+    derive(serde::Serialize, serde::Deserialize, Hash)
+)]
+#[derive(Clone, Copy, Debug, PartialEq)]
+enum Companion {
+    /// The breakaway alone, against the expected one.
+    Alone,
+    /// The acceptance readings of a relieved pack: the opening takes the load out.
+    Acceptance(Acceptance),
+    /// A spring-only pack's uncoupled push: its judge, on the loaded push's drive and timing.
+    Uncoupled(TestJudge),
 }
 
 /// A unit's acceptance readings and `ΔĈ = k_b·ΔT_b − k_o·ΔT_o`'s weights.
@@ -179,21 +220,56 @@ pub enum Procedure {
 }
 
 impl TestSettings {
-    /// Checks the loaded test's settings (`c.functional_test`) against the configuration.
+    /// Checks the test's settings (`c.functional_test`, and `c.uncoupled_test` if set) against
+    /// the configuration.
     pub fn new(c: &Config) -> Result<TestSettings, ConfigError> {
-        TestSettings::build(c, &c.functional_test)
+        let mut s = TestSettings::build(c, &c.functional_test)?;
+        if let Some(t) = &c.uncoupled_test {
+            s.companion = Companion::Uncoupled(TestSettings::uncoupled(c, t)?);
+        }
+        Ok(s)
     }
 
-    /// The uncoupled test's (`c.uncoupled_test`), if set: a spring-only pack's only, judged
-    /// on its breakaway alone; errors name `uncoupled_test.*`.
-    pub fn uncoupled(c: &Config) -> Result<Option<TestSettings>, ConfigError> {
-        let Some(t) = &c.uncoupled_test else {
-            return Ok(None);
-        };
+    /// The uncoupled push's judge: a spring-only pack's only, judged on its breakaway alone, on
+    /// the loaded test's drive and timing; errors name `uncoupled_test.*`.
+    fn uncoupled(c: &Config, t: &TestConfig) -> Result<TestJudge, ConfigError> {
         require(c.driving_pack == DrivingPack::SpringOnly, "uncoupled_test")?;
+        let l = &c.functional_test;
+        for (same, key) in [
+            (
+                t.torque_rate_nm_s == l.torque_rate_nm_s,
+                "uncoupled_test.torque_rate_nm_s",
+            ),
+            (
+                t.max_torque_nm == l.max_torque_nm,
+                "uncoupled_test.max_torque_nm",
+            ),
+            (t.open_s == l.open_s, "uncoupled_test.open_s"),
+            (t.settle_s == l.settle_s, "uncoupled_test.settle_s"),
+            (
+                t.breakaway_rad == l.breakaway_rad,
+                "uncoupled_test.breakaway_rad",
+            ),
+            (
+                t.torque_filter_hz == l.torque_filter_hz,
+                "uncoupled_test.torque_filter_hz",
+            ),
+            (t.load_nm * l.load_nm > 0.0, "uncoupled_test.load_nm"),
+        ] {
+            require(same, key)?;
+        }
         TestSettings::build(c, t)
-            .map(Some)
+            .map(|s| s.judge)
             .map_err(|e| e.renamed(uncoupled_name(e.parameter())))
+    }
+
+    /// The judge of `procedure`, if configured.
+    pub(crate) fn judge(&self, procedure: Procedure) -> Option<&TestJudge> {
+        match (procedure, &self.companion) {
+            (Procedure::Loaded, _) => Some(&self.judge),
+            (Procedure::Uncoupled, Companion::Uncoupled(j)) => Some(j),
+            (Procedure::Uncoupled, _) => None,
+        }
     }
 
     fn build(c: &Config, t: &TestConfig) -> Result<TestSettings, ConfigError> {
@@ -258,13 +334,15 @@ impl TestSettings {
         let hz = positive(t.torque_filter_hz, "functional_test.torque_filter_hz")?;
         let tick_hz = tick_hz(c)?;
         Ok(TestSettings {
-            sign: if load > 0.0 { 1 } else { -1 },
-            load: q16(l, "functional_test.load_nm")?,
-            lever: q16(1.0 + g, "capacity_mu")?,
-            expected_capacity: q16(expected, "functional_test.expected_breakaway_nm")?,
-            min_capacity: q16(expected * margin, "functional_test.min_margin")?,
-            max_capacity: q16(expected * top, "functional_test.max_margin")?,
-            acceptance,
+            judge: TestJudge {
+                sign: if load > 0.0 { 1 } else { -1 },
+                load: q16(l, "functional_test.load_nm")?,
+                lever: q16(1.0 + g, "capacity_mu")?,
+                expected_capacity: q16(expected, "functional_test.expected_breakaway_nm")?,
+                min_capacity: q16(expected * margin, "functional_test.min_margin")?,
+                max_capacity: q16(expected * top, "functional_test.max_margin")?,
+            },
+            companion: acceptance.map_or(Companion::Alone, Companion::Acceptance),
             measure_from: open_ticks / 2,
             open_ticks,
             push_from,
@@ -281,21 +359,15 @@ impl TestSettings {
     }
 }
 
-/// A loaded-test parameter's name for the uncoupled test (shared ones unchanged).
+/// A loaded-test parameter's name for the uncoupled test (the drive's and shared ones unchanged).
 fn uncoupled_name(p: &'static str) -> &'static str {
     match p {
         "functional_test.load_nm" => "uncoupled_test.load_nm",
-        "functional_test.torque_rate_nm_s" => "uncoupled_test.torque_rate_nm_s",
-        "functional_test.max_torque_nm" => "uncoupled_test.max_torque_nm",
-        "functional_test.open_s" => "uncoupled_test.open_s",
-        "functional_test.settle_s" => "uncoupled_test.settle_s",
-        "functional_test.breakaway_rad" => "uncoupled_test.breakaway_rad",
         "functional_test.expected_breakaway_nm" => "uncoupled_test.expected_breakaway_nm",
         "functional_test.expected_opening_nm" => "uncoupled_test.expected_opening_nm",
         "functional_test.min_margin" => "uncoupled_test.min_margin",
         "functional_test.max_margin" => "uncoupled_test.max_margin",
         "functional_test.load_tolerance" => "uncoupled_test.load_tolerance",
-        "functional_test.torque_filter_hz" => "uncoupled_test.torque_filter_hz",
         shared => shared,
     }
 }
@@ -391,6 +463,7 @@ impl FunctionalTest {
     pub(crate) fn step(
         &mut self,
         s: &TestSettings,
+        judge: &TestJudge,
         x: &Sensed,
         drive_torque: Q16,
         flags: Flags,
@@ -402,7 +475,7 @@ impl FunctionalTest {
             self.report.result = TestResult::Aborted;
             return self.report;
         }
-        let along = if s.sign > 0 {
+        let along = if judge.sign > 0 {
             drive_torque
         } else {
             drive_torque.saturating_neg()
@@ -428,11 +501,11 @@ impl FunctionalTest {
             return self.report;
         }
         let rest = *self.rest_count.get_or_insert(x.out);
-        let travel = s.sign * counter_delta(rest, x.out, s.out_bits);
+        let travel = judge.sign * counter_delta(rest, x.out, s.out_bits);
         self.torque = lowpass(self.torque, along, s.alpha);
         self.report.breakaway_torque_nm = self.report.breakaway_torque_nm.max(self.torque);
         if travel >= s.breakaway_counts {
-            self.decide(s);
+            self.decide(s, judge);
         } else if tick.saturating_sub(s.push_from) > s.limit_ticks {
             self.report.result = TestResult::Fail;
         }
@@ -441,10 +514,14 @@ impl FunctionalTest {
 
     /// The capacity (and the load) from the breakaway and the opening when commissioned on
     /// both, else from the breakaway alone, against the band.
-    fn decide(&mut self, s: &TestSettings) {
+    fn decide(&mut self, s: &TestSettings, j: &TestJudge) {
         let r = &mut self.report;
         let t_b = r.breakaway_torque_nm;
-        let (capacity, load_ok) = match s.acceptance {
+        let acceptance = match (r.procedure, &s.companion) {
+            (Procedure::Loaded, Companion::Acceptance(a)) => Some(a),
+            _ => None,
+        };
+        let (capacity, load_ok) = match acceptance {
             Some(a) => {
                 let d_o = r.opening_torque_nm.saturating_sub(a.opening);
                 let d_c0 = a
@@ -452,22 +529,22 @@ impl FunctionalTest {
                     .saturating_mul(t_b.saturating_sub(a.breakaway))
                     .saturating_sub(a.k_o.saturating_mul(d_o));
                 let d_l = d_o.saturating_sub(a.drag.saturating_mul(d_c0));
-                r.load_nm = s.load.saturating_add(d_l);
+                r.load_nm = j.load.saturating_add(d_l);
                 (
-                    s.expected_capacity.saturating_add(d_c0),
+                    j.expected_capacity.saturating_add(d_c0),
                     d_l.saturating_abs() <= a.load_error,
                 )
             }
             None => {
-                r.load_nm = s.load;
-                (s.load.saturating_add(s.lever.saturating_mul(t_b)), true)
+                r.load_nm = j.load;
+                (j.load.saturating_add(j.lever.saturating_mul(t_b)), true)
             }
         };
         r.capacity_nm = capacity;
         r.margin = capacity
-            .checked_div(s.expected_capacity)
+            .checked_div(j.expected_capacity)
             .unwrap_or(Q16::ZERO);
-        let within = capacity >= s.min_capacity && capacity <= s.max_capacity;
+        let within = capacity >= j.min_capacity && capacity <= j.max_capacity;
         r.result = if t_b > Q16::ZERO && within && load_ok {
             TestResult::Pass
         } else {
@@ -479,11 +556,16 @@ impl FunctionalTest {
     pub fn report(&self) -> TestReport {
         self.report
     }
-}
 
-impl FunctionalTest {
     /// The procedure requested.
     pub fn procedure(&self) -> Procedure {
         self.report.procedure
+    }
+
+    /// Ends a running test with nothing concluded.
+    pub(crate) fn abort(&mut self) {
+        if self.report.result == TestResult::Running {
+            self.report.result = TestResult::Aborted;
+        }
     }
 }

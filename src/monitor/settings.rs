@@ -28,8 +28,6 @@ pub struct Settings {
     pub(crate) estimate: EstimateSettings,
     pub(crate) checks: CheckSettings,
     pub(crate) functional_test: TestSettings,
-    /// The test with the output uncoupled, once commissioned on a spring-only pack.
-    pub(crate) uncoupled_test: Option<TestSettings>,
     /// A spring-only pack's aiding load from its braking, once commissioning identified it.
     pub(crate) aiding: Option<AidingSettings>,
     /// No estimate is trusted unless the monitor was set for its plant.
@@ -53,7 +51,6 @@ impl Settings {
             estimate: EstimateSettings::new(c)?,
             checks: CheckSettings::new(c, &pack, &ratios)?,
             functional_test: TestSettings::new(c)?,
-            uncoupled_test: TestSettings::uncoupled(c)?,
             aiding: AidingSettings::new(c)?,
             commissioned: c.commissioned,
         })

@@ -1,7 +1,7 @@
-//! What every firmware image under QEMU shares, whatever its board: the semihosting
-//! arguments (`trace=FILE`, `bench`, `overrun-at=N`, `reset-every=N`, `trip-log=FILE`,
-//! `config=FILE`, `functional-test-at=N`, `uncoupled-test-at=N`), the trace it streams from the host, the boot self-check, the bench loop that
-//! counts instructions, and the log lines the xtask decodes (`cargo xtask run` parses them).
+//! What every firmware image under QEMU shares, whatever its board: the semihosting arguments
+//! (`trace=FILE`, `bench`, `overrun-at=N`, `reset-every=N`, `trip-log=FILE`, `config=FILE`,
+//! `functional-test-at=N`, `uncoupled-test-at=N`), the trace it streams from the host, the boot
+//! self-check, the bench loop that counts instructions, and the log lines the xtask decodes.
 
 use crate::app::{estimate_checksum, Ticker};
 use crate::board::SampleSource;

@@ -19,8 +19,7 @@ pub struct CommissionArgs {
     /// (`.csv`): the drive opens against (or closes with) a known load, is cut, and the brake
     /// holds; two openings at loads 5 N·m or more apart also give the current's gain, two
     /// closings so the overrunning line (docs/commissioning.md). A `functional_test` scene
-    /// among them sets the functional test's expected breakaway; one at 1 N·m or less, a
-    /// spring-only pack's uncoupled push.
+    /// sets the test's expected breakaway (at 1 N·m or less, a spring-only pack's uncoupled push).
     #[arg(value_name = "SCENE|FILE|TRACE.csv", required = true)]
     pub targets: Vec<String>,
     /// The load the crew applied in each run, in order (N·m); a scene's own load when not given,
@@ -76,28 +75,36 @@ pub fn main(a: &CommissionArgs) -> Result<i32, String> {
         Err(e) => return Ok(bad_input("commission", &e)),
     };
     let mut test_note = String::new();
-    let mut kinds = Vec::new();
-    for (trace, scene) in &test_runs {
-        let (kind, procedure) = procedure_of(scene);
-        if kinds.contains(&kind) {
-            return Ok(bad_input(
-                "commission",
-                &format!("two {kind:?} functional tests given: one of each at most"),
-            ));
-        }
-        kinds.push(kind);
+    let mut tests: Vec<_> = test_runs
+        .iter()
+        .map(|(trace, scene)| (procedure_of(scene), trace, scene))
+        .collect();
+    // The loaded push first: the uncoupled one runs on its drive and timing.
+    tests.sort_by_key(|((kind, _), _, _)| *kind == Procedure::Uncoupled);
+    if tests.len() > 1 && tests[0].0 .0 == tests[1].0 .0 {
+        return Ok(bad_input(
+            "commission",
+            "two functional tests of one procedure given: one loaded and one uncoupled at most",
+        ));
+    }
+    for ((kind, procedure), trace, scene) in tests {
+        let name = match kind {
+            Procedure::Loaded => "loaded",
+            Procedure::Uncoupled => "uncoupled",
+        };
         if kind == Procedure::Uncoupled && c.config.driving_pack != DrivingPack::SpringOnly {
             return Ok(bad_input(
                 "commission",
                 "the uncoupled push is for a spring-only pack; these runs identified a relieved one",
             ));
         }
-        let Some(mut t) = accept(trace, c.config, (kind, &procedure), scene.test.start_s)? else {
+        let Some(mut t) = (match accept(trace, c.config, (kind, &procedure), scene.test.start_s) {
+            Ok(t) => t,
+            Err(e) => return Ok(bad_input("commission", &format!("the {name} push: {e}"))),
+        }) else {
             return Ok(bad_input(
                 "commission",
-                &format!(
-                    "the acceptance functional test ({kind:?}) did not pass: the unit is not healthy"
-                ),
+                &format!("the {name} acceptance push failed: the unit is not healthy"),
             ));
         };
         // The file carries the acceptance readings to the millinewton-metre.
@@ -113,8 +120,7 @@ pub fn main(a: &CommissionArgs) -> Result<i32, String> {
             Procedure::Uncoupled => c.config.uncoupled_test = Some(t),
         }
         test_note += &format!(
-            ", {} functional test breakaway {b} N·m, opening {o} N·m at {} N·m",
-            format!("{kind:?}").to_lowercase(),
+            ", {name} functional test breakaway {b} N·m, opening {o} N·m at {} N·m",
             procedure.load_nm
         );
     }

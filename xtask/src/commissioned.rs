@@ -51,7 +51,7 @@ pub fn functional_test_on_firmware() -> Result<(), String> {
         "functional_test_spring_half",
         "[scene]\nkind = \"functional_test\"\n[[fault]]\nkind = \"spring_broken\"\nat_s = 0.0\nseverity = 0.5\n",
     )?;
-    pass_then_fail(&["functional_test".to_string(), spring], c)
+    pass_then_fail(&["functional_test".to_string(), spring], c, "loaded")
 }
 
 /// The uncoupled push under QEMU: a paper-form unit, commissioned as a spring-only pack with
@@ -81,7 +81,7 @@ pub fn uncoupled_test_on_firmware() -> Result<(), String> {
         accept(&trace, c, (Procedure::Uncoupled, &uncoupled), start)?
             .ok_or("the healthy unit's uncoupled push did not break away")?,
     );
-    pass_then_fail(&[healthy, worn], c)
+    pass_then_fail(&[healthy, worn], c, "uncoupled")
 }
 
 /// A scene file in target/replay; returns its path.
@@ -93,8 +93,9 @@ fn scene_file(stem: &str, text: &str) -> Result<String, String> {
     Ok(path.to_string_lossy().into_owned())
 }
 
-/// Runs `scenes` on the M3 firmware with `config`; the first must pass, the second fail.
-fn pass_then_fail(scenes: &[String], config: Config) -> Result<(), String> {
+/// Runs `scenes` on the M3 firmware with `config`; both must run the `expected` procedure, the
+/// first pass, the second fail.
+fn pass_then_fail(scenes: &[String], config: Config, expected: &str) -> Result<(), String> {
     let mut verdicts = Vec::new();
     for scene in scenes {
         let (report, ok) =
@@ -105,18 +106,18 @@ fn pass_then_fail(scenes: &[String], config: Config) -> Result<(), String> {
                 "{scene}: the firmware's test differs from the host's or the run failed"
             ));
         }
-        verdicts.push(
-            report["functional_test"]["result"]
-                .as_str()
-                .unwrap_or("")
-                .to_string(),
-        );
+        let t = &report["functional_test"];
+        verdicts.push(format!(
+            "{} {}",
+            t["procedure"].as_str().unwrap_or(""),
+            t["result"].as_str().unwrap_or("")
+        ));
     }
-    if verdicts == ["pass", "fail"] {
+    if verdicts == [format!("{expected} pass"), format!("{expected} fail")] {
         Ok(())
     } else {
         Err(format!(
-            "functional test verdicts {verdicts:?}, expected pass then fail"
+            "functional test verdicts {verdicts:?}, expected {expected} pass then fail"
         ))
     }
 }

@@ -61,11 +61,12 @@ fn functional_test_json(
     scene: &Scene,
 ) -> Result<serde_json::Value, String> {
     let (kind, test) = host_tests::dormant::procedure_of(scene);
-    let (config, kind) = crate::run::test_configuration(config, kind, test)?;
+    let config = crate::run::test_configuration(config, kind, test)?;
     let test = match kind {
-        Procedure::Loaded => config.functional_test,
-        Procedure::Uncoupled => config.uncoupled_test.unwrap_or(test),
-    };
+        Procedure::Loaded => Some(config.functional_test),
+        Procedure::Uncoupled => config.uncoupled_test,
+    }
+    .ok_or("the configuration has no uncoupled push")?;
     let r = run_functional_test(trace, config, (kind, &test), scene.test.start_s)?;
     Ok(json!({
         "procedure": format!("{:?}", r.procedure).to_lowercase(),

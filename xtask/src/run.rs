@@ -129,27 +129,25 @@ fn functional_test_of(scene: &str) -> Option<(Procedure, TestConfig, f64)> {
     })
 }
 
-/// The configuration and the procedure a test scene runs on: a configuration file's procedure
-/// stands (a commissioned unit's acceptance readings); without one, the loaded procedure as the
-/// scene sets it (the uncommissioned monitor has no uncoupled push).
+/// The configuration a test scene runs on: a configuration file's (a commissioned unit's
+/// acceptance readings), else the defaults with the loaded procedure as the scene sets it. The
+/// uncoupled push needs a configuration carrying it.
 pub fn test_configuration(
     config: Option<Config>,
     kind: Procedure,
     test: TestConfig,
-) -> Result<(Config, Procedure), String> {
-    match config {
-        Some(c) if kind == Procedure::Uncoupled && c.uncoupled_test.is_none() => Err(format!(
-            "a functional_test scene at {} N·m is the uncoupled push; the configuration has none (commission the unit with one)",
+) -> Result<Config, String> {
+    match (config, kind) {
+        (Some(c), Procedure::Uncoupled) if c.uncoupled_test.is_some() => Ok(c),
+        (_, Procedure::Uncoupled) => Err(format!(
+            "a functional_test scene at {} N·m is the uncoupled push: give a --config that carries one (commission the unit with it)",
             test.load_nm
         )),
-        Some(c) => Ok((c, kind)),
-        None => Ok((
-            Config {
-                functional_test: test,
-                ..Config::default()
-            },
-            Procedure::Loaded,
-        )),
+        (Some(c), Procedure::Loaded) => Ok(c),
+        (None, Procedure::Loaded) => Ok(Config {
+            functional_test: test,
+            ..Config::default()
+        }),
     }
 }
 
@@ -186,7 +184,7 @@ pub fn replay_report_with(
     // A functional-test scene: the crew requests the test when its ramp starts.
     let (config, test_at) = match functional_test_of(scene) {
         Some((kind, test, start_s)) => {
-            let (c, kind) = test_configuration(config, kind, test)?;
+            let c = test_configuration(config, kind, test)?;
             let at = (start_s * trace.sample_rate_hz).round() as u32;
             (Some(c), Some((at, kind)))
         }

@@ -119,7 +119,7 @@ pub fn replay(bytes: &[u8], config: Config) -> Result<(bool, String), String> {
         .settings_digest();
     if digest != r.config_digest {
         return Err(format!(
-            "the record's configuration digest {:#010x} is not this configuration's {digest:#010x}",
+            "the record's configuration digest {:#010x} is not that of the configuration it replays on, {digest:#010x}",
             r.config_digest
         ));
     }

@@ -228,7 +228,8 @@ pub fn main(a: &FamilyArgs) -> Result<(), String> {
          two-sided 95 % Clopper–Pearson interval (false alarms: its upper bound per run); after \
          a kind's rate, its runs in that form whose fault never manifested (*dormant*, \
          monitor.md, \"How it is measured\"), how many of those were found, by the drive's \
-         own cycle (`brake_degraded` in the run) or by the functional test after it, and after \
+         own cycle (`brake_degraded` in the run) or by the functional test after it (on a unit \
+         commissioned as a spring-only pack, the loaded and the uncoupled push), and after \
          how many that test ran (*tested*; functional-test.md); and, where any, those whose plant came apart \
          without the fault (*plant apart*, counted apart as a nominal run is; model.md, \
          \"The plant family\"). Functional tests failed: of the nominal runs the test \
