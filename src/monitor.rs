@@ -379,13 +379,7 @@ impl Monitor {
         (st.gave_way, st.reading_switch) = (gave_way, reading_switch);
         st.latch(raised.union(fast));
         if let Some(test) = st.test.as_mut() {
-            match k.functional_test.judge(test.procedure()) {
-                Some(j) => {
-                    test.step(&k.functional_test, j, x, o.drive_torque, st.flags);
-                }
-                // A state restored onto a configuration without this procedure.
-                None => test.abort(),
-            }
+            test.step(&k.functional_test, x, o.drive_torque, st.flags);
         }
     }
 }

@@ -88,7 +88,7 @@ fn main() -> Result<(), String> {
         }
         let commissioned = test.commissioned(
             r0.breakaway_torque_nm.to_num::<f64>(),
-            r0.opening_torque_nm.to_num::<f64>(),
+            Some(r0.opening_torque_nm.to_num::<f64>()),
         );
         let alone = TestConfig {
             expected_opening_nm: None,

@@ -346,8 +346,8 @@ mod tests {
             load_nm: 18.5,
             ..TestConfig::DEFAULT
         }
-        .commissioned(10.25, 24.5);
-        c.uncoupled_test = Some(TestConfig::UNCOUPLED.commissioned(8.125, 1.5));
+        .commissioned(10.25, Some(24.5));
+        c.uncoupled_test = Some(TestConfig::UNCOUPLED.commissioned(8.125, None));
         c.aiding_braking = Some(AidingBraking {
             inertia_kg_m2: 0.1512345,
             drag_nm: 8.25,

@@ -7,7 +7,6 @@
 
 use crate::accuracy::{run_functional_test, scene_trace};
 use crate::mc::Draw;
-use noback::fx::Q16;
 use noback::monitor::functional_test::{Procedure, TestConfig, TestResult};
 use noback::monitor::{Config, DrivingPack};
 use noback_twin::fault::{Fault, FaultKind};
@@ -59,8 +58,7 @@ pub fn procedure_of(scene: &Scene) -> (Procedure, TestConfig) {
 }
 
 /// The acceptance test on a healthy unit's `trace`: the procedure commissioned on its readings
-/// if the unit passed against the design (loaded) or broke away at all (uncoupled, which the
-/// design does not predict: docs/functional-test.md), else `None`.
+/// if the unit passed against the design, else `None`.
 pub fn accept(
     trace: &Trace,
     config: Config,
@@ -68,17 +66,10 @@ pub fn accept(
     start_s: f64,
 ) -> Result<Option<TestConfig>, String> {
     let r = run_functional_test(trace, config, (kind, procedure), start_s)?;
-    let accepted = match kind {
-        Procedure::Loaded => r.result == TestResult::Pass,
-        Procedure::Uncoupled => {
-            r.result != TestResult::Aborted
-                && r.breakaway_torque_nm > Q16::ZERO
-                && r.capacity_nm > Q16::ZERO
-        }
-    };
-    Ok(accepted.then(|| {
-        procedure.commissioned(r.breakaway_torque_nm.to_num(), r.opening_torque_nm.to_num())
-    }))
+    // Only the loaded push has a door to open against.
+    let opening = (kind == Procedure::Loaded).then(|| r.opening_torque_nm.to_num());
+    Ok((r.result == TestResult::Pass)
+        .then(|| procedure.commissioned(r.breakaway_torque_nm.to_num(), opening)))
 }
 
 /// A fault of `kind` and `severity` present from the start.

@@ -50,7 +50,7 @@ fn commissioned_on_its_healthy_test() -> TestConfig {
     let accepted = report(None, &TestConfig::DEFAULT);
     TestConfig::DEFAULT.commissioned(
         accepted.breakaway_torque_nm.to_num(),
-        accepted.opening_torque_nm.to_num(),
+        Some(accepted.opening_torque_nm.to_num()),
     )
 }
 
@@ -191,7 +191,7 @@ fn a_spring_only_unit_reads_a_lost_spring_as_a_loss() {
         let healthy = paper_report_on(config, None, &TestConfig::DEFAULT, 1.0);
         let unit = TestConfig::DEFAULT.commissioned(
             healthy.breakaway_torque_nm.to_num(),
-            healthy.opening_torque_nm.to_num(),
+            Some(healthy.opening_torque_nm.to_num()),
         );
         let r = paper_report_on(config, Some((FaultKind::SpringBroken, 0.5)), &unit, 1.0);
         let margin: f64 = r.margin.to_num();
@@ -215,7 +215,7 @@ fn the_paper_reading_runs_the_test_healthy_passes_and_dormant_faults_fail() {
     assert_eq!(jam.result, TestResult::Fail, "{jam:?}");
     let unit = TestConfig::DEFAULT.commissioned(
         healthy.breakaway_torque_nm.to_num(),
-        healthy.opening_torque_nm.to_num(),
+        Some(healthy.opening_torque_nm.to_num()),
     );
     for scale in [0.95, 1.05] {
         let r = paper_report(None, &unit, scale);
@@ -268,10 +268,9 @@ fn uncoupled_report(
     .unwrap()
 }
 
-/// With no door load to misjudge, a spring-only pack's breakaway is its spring's clamp: the
-/// uncoupled push passes the healthy unit at a set torque ±0.05 N·m off and fails a pack worn
-/// by half, which moves the loaded push by less than the door load's ±5 % does
-/// (docs/functional-test.md, "The uncoupled push").
+/// With no door load to misjudge, a spring-only pack breaks away at its spring's clamp, as
+/// designed; commissioned, the push passes the healthy unit ±0.05 N·m off and fails a pack worn
+/// by half (docs/functional-test.md, "The uncoupled push").
 #[test]
 fn the_uncoupled_push_finds_a_worn_spring_only_pack() {
     let mut unit = Config {
@@ -289,8 +288,19 @@ fn the_uncoupled_push_finds_a_worn_spring_only_pack() {
         s.test.start_s,
     )
     .unwrap();
+    let design = uncoupled_report(unit, None, TestConfig::UNCOUPLED.load_nm);
+    assert_eq!(
+        design.result,
+        TestResult::Pass,
+        "against the design: {design:?}"
+    );
+    let t_b = design.capacity_nm - design.load_nm;
+    assert_eq!(t_b, design.breakaway_torque_nm, "C₀ = L + T_b: {design:?}");
     unit.uncoupled_test = accepted;
-    assert!(unit.uncoupled_test.is_some(), "the healthy unit broke away");
+    let commissioned = unit
+        .uncoupled_test
+        .expect("the healthy unit passed acceptance");
+    assert_eq!(commissioned.expected_opening_nm, None);
     for load in [0.25, 0.35] {
         let r = uncoupled_report(unit, None, load);
         assert_eq!(r.result, TestResult::Pass, "healthy at {load} N·m: {r:?}");
@@ -342,6 +352,16 @@ fn the_uncoupled_push_needs_a_spring_only_unit() {
         Monitor::new(other_drive).err(),
         Some(ConfigError::OutOfRange {
             parameter: "uncoupled_test.open_s"
+        })
+    );
+    let opening = Config {
+        uncoupled_test: Some(TestConfig::UNCOUPLED.commissioned(9.0, Some(1.0))),
+        ..bad
+    };
+    assert_eq!(
+        Monitor::new(opening).err(),
+        Some(ConfigError::OutOfRange {
+            parameter: "uncoupled_test.expected_opening_nm"
         })
     );
     let mut m = Monitor::new(Config::default()).unwrap();

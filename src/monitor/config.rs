@@ -442,7 +442,7 @@ pub enum ConfigError {
 
 impl ConfigError {
     /// The same error naming `parameter` instead.
-    pub const fn renamed(self, parameter: &'static str) -> ConfigError {
+    pub(crate) const fn renamed(self, parameter: &'static str) -> ConfigError {
         match self {
             ConfigError::NotFinite { .. } => ConfigError::NotFinite { parameter },
             ConfigError::OutOfRange { .. } => ConfigError::OutOfRange { parameter },

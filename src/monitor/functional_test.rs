@@ -13,7 +13,9 @@
 //! k_o·(T_o − T_o⁰)`; a spring-only pack (`d ≈ q/p`) is judged on its breakaway alone. The test
 //! passes when `Ĉ` lies within `min_margin … max_margin` of the expected capacity (the design's,
 //! or the unit's own), the load both readings imply lies within `load_tolerance` of the set one,
-//! and the output broke away before the torque limit.
+//! and the output broke away before the torque limit. A spring-only pack is also pushed with its
+//! output uncoupled: a small set `L` climbs no ramp, so `Ĉ = C₀ = L + T_b`, with no door load to
+//! misjudge.
 //!
 //! | quantity | format | range | resolution |
 //! |---|---|---|---|
@@ -22,12 +24,13 @@
 //! | output travel | `i32` counts, saturating sum of wrapping deltas | ±2^31 | 1 count |
 //! | margin | [`Q16`], capacity over expected | 0 … 32 768 | 1.5e-5 |
 
-use super::config::{Config, ConfigError, DrivingPack};
-use super::convert::{filter_gain, finite, positive, q16, require, ticks};
+mod settings;
+
 use super::io::Flags;
-use super::schedule::EVERY_TICK;
 use super::sense::Sensed;
-use crate::fx::{counter_delta, lowpass, Gain, Q16};
+use crate::fx::{counter_delta, lowpass, Q16};
+pub use settings::TestSettings;
+use settings::{Companion, TestJudge};
 
 /// What the ground crew sets for the test (SI). [`TestConfig::DEFAULT`] is the twin's default
 /// `functional_test` scene.
@@ -48,8 +51,8 @@ pub struct TestConfig {
     pub settle_s: f64,
     /// Output travel that counts as breakaway (rad).
     pub breakaway_rad: f64,
-    /// The expected breakaway torque at `load_nm` (N·m): `None` = the design's,
-    /// `(C(L) − L)/(1 + g)` from the configuration's mechanism and `capacity_mu`.
+    /// The expected breakaway torque at `load_nm` (N·m): `None` = the design's from the
+    /// configuration's mechanism and `capacity_mu`, `(C(L) − L)/(1 + g)` (uncoupled `C₀ − L`).
     pub expected_breakaway_nm: Option<f64>,
     /// The unit's opening torque at its acceptance test (N·m): with `expected_breakaway_nm`, a
     /// relieved pack's capacity comes from both readings; `None` (or a spring-only pack) = from
@@ -107,13 +110,13 @@ impl TestConfig {
         }
     }
 
-    /// This procedure on a unit whose acceptance test under it opened at `opening_nm` and broke
-    /// away at `breakaway_nm`: pass within [`COMMISSIONED_MIN_MARGIN`] …
+    /// This procedure on a unit whose acceptance test under it broke away at `breakaway_nm`
+    /// (and opened at `opening_nm`, loaded): pass within [`COMMISSIONED_MIN_MARGIN`] …
     /// [`COMMISSIONED_MAX_MARGIN`] of that capacity.
-    pub fn commissioned(self, breakaway_nm: f64, opening_nm: f64) -> TestConfig {
+    pub fn commissioned(self, breakaway_nm: f64, opening_nm: Option<f64>) -> TestConfig {
         TestConfig {
             expected_breakaway_nm: Some(breakaway_nm),
-            expected_opening_nm: Some(opening_nm),
+            expected_opening_nm: opening_nm,
             min_margin: COMMISSIONED_MIN_MARGIN,
             max_margin: COMMISSIONED_MAX_MARGIN,
             ..self
@@ -133,78 +136,6 @@ pub const COMMISSIONED_MIN_MARGIN: f64 = 0.95;
 /// Upper end of the commissioned band.
 pub const COMMISSIONED_MAX_MARGIN: f64 = 1.05;
 
-/// The test's constants, converted once.
-#[cfg_attr(
-    feature = "config-block",
-    derive(serde::Serialize, serde::Deserialize, Hash)
-)]
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct TestSettings {
-    /// The loaded push's load and band.
-    judge: TestJudge,
-    /// A relieved pack's acceptance readings, or a spring-only pack's uncoupled push.
-    companion: Companion,
-    /// Ticks from the request: the opening's measured half starts, the opening ends, the push
-    /// starts.
-    measure_from: u32,
-    open_ticks: u32,
-    push_from: u32,
-    /// Ticks of the ramp until the torque limit, plus a settling allowance.
-    limit_ticks: u32,
-    breakaway_counts: i32,
-    out_bits: u8,
-    alpha: Gain,
-}
-
-/// What a push is judged by: its load's sign and size, `1 + g`, the expected capacity and its
-/// band. The uncoupled push keeps only this, and runs the loaded push's drive and timing.
-#[cfg_attr(
-    feature = "config-block",
-    derive(serde::Serialize, serde::Deserialize, Hash)
-)]
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct TestJudge {
-    sign: i32,
-    load: Q16,
-    lever: Q16,
-    expected_capacity: Q16,
-    min_capacity: Q16,
-    max_capacity: Q16,
-}
-
-/// What the loaded push carries beside its judge; never both (a relieved pack has no uncoupled
-/// push, a spring-only pack no opening reading), so they share the room.
-#[cfg_attr(
-    feature = "config-block",
-    derive(serde::Serialize, serde::Deserialize, Hash)
-)]
-#[derive(Clone, Copy, Debug, PartialEq)]
-enum Companion {
-    /// The breakaway alone, against the expected one.
-    Alone,
-    /// The acceptance readings of a relieved pack: the opening takes the load out.
-    Acceptance(Acceptance),
-    /// A spring-only pack's uncoupled push: its judge, on the loaded push's drive and timing.
-    Uncoupled(TestJudge),
-}
-
-/// A unit's acceptance readings and `ΔĈ = k_b·ΔT_b − k_o·ΔT_o`'s weights.
-#[cfg_attr(
-    feature = "config-block",
-    derive(serde::Serialize, serde::Deserialize, Hash)
-)]
-#[derive(Clone, Copy, Debug, PartialEq)]
-struct Acceptance {
-    breakaway: Q16,
-    opening: Q16,
-    k_b: Q16,
-    k_o: Q16,
-    /// `d`: the opening torque per N·m of `C₀`.
-    drag: Q16,
-    /// Largest `|L̂ − L|` that passes (N·m).
-    load_error: Q16,
-}
-
 /// Which of the unit's procedures the crew runs.
 #[cfg_attr(
     feature = "config-block",
@@ -217,164 +148,6 @@ pub enum Procedure {
     /// The output uncoupled from the door (`Config::uncoupled_test`): a spring-only pack's
     /// wear, which the door load's uncertainty hides in the loaded push.
     Uncoupled,
-}
-
-impl TestSettings {
-    /// Checks the test's settings (`c.functional_test`, and `c.uncoupled_test` if set) against
-    /// the configuration.
-    pub fn new(c: &Config) -> Result<TestSettings, ConfigError> {
-        let mut s = TestSettings::build(c, &c.functional_test)?;
-        if let Some(t) = &c.uncoupled_test {
-            s.companion = Companion::Uncoupled(TestSettings::uncoupled(c, t)?);
-        }
-        Ok(s)
-    }
-
-    /// The uncoupled push's judge: a spring-only pack's only, judged on its breakaway alone, on
-    /// the loaded test's drive and timing; errors name `uncoupled_test.*`.
-    fn uncoupled(c: &Config, t: &TestConfig) -> Result<TestJudge, ConfigError> {
-        require(c.driving_pack == DrivingPack::SpringOnly, "uncoupled_test")?;
-        let l = &c.functional_test;
-        for (same, key) in [
-            (
-                t.torque_rate_nm_s == l.torque_rate_nm_s,
-                "uncoupled_test.torque_rate_nm_s",
-            ),
-            (
-                t.max_torque_nm == l.max_torque_nm,
-                "uncoupled_test.max_torque_nm",
-            ),
-            (t.open_s == l.open_s, "uncoupled_test.open_s"),
-            (t.settle_s == l.settle_s, "uncoupled_test.settle_s"),
-            (
-                t.breakaway_rad == l.breakaway_rad,
-                "uncoupled_test.breakaway_rad",
-            ),
-            (
-                t.torque_filter_hz == l.torque_filter_hz,
-                "uncoupled_test.torque_filter_hz",
-            ),
-            (t.load_nm * l.load_nm > 0.0, "uncoupled_test.load_nm"),
-        ] {
-            require(same, key)?;
-        }
-        TestSettings::build(c, t)
-            .map(|s| s.judge)
-            .map_err(|e| e.renamed(uncoupled_name(e.parameter())))
-    }
-
-    /// The judge of `procedure`, if configured.
-    pub(crate) fn judge(&self, procedure: Procedure) -> Option<&TestJudge> {
-        match (procedure, &self.companion) {
-            (Procedure::Loaded, _) => Some(&self.judge),
-            (Procedure::Uncoupled, Companion::Uncoupled(j)) => Some(j),
-            (Procedure::Uncoupled, _) => None,
-        }
-    }
-
-    fn build(c: &Config, t: &TestConfig) -> Result<TestSettings, ConfigError> {
-        let m = &c.mechanism;
-        let load = finite(t.load_nm, "functional_test.load_nm")?;
-        require(load != 0.0, "functional_test.load_nm")?;
-        let rate = positive(t.torque_rate_nm_s, "functional_test.torque_rate_nm_s")?;
-        let max = positive(t.max_torque_nm, "functional_test.max_torque_nm")?;
-        let per_n = m.pack_torque_per_newton_m(finite(c.capacity_mu, "capacity_mu")?);
-        let g = per_n * m.ramp_factor_per_m();
-        require(g.is_finite() && g > 0.0, "capacity_mu")?;
-        let c0 = per_n * m.spring_preload_n();
-        let l = load.abs();
-        let expected_b = match t.expected_breakaway_nm {
-            Some(b) => positive(b, "functional_test.expected_breakaway_nm")?,
-            None => (c0 + (g - 1.0) * l) / (1.0 + g),
-        };
-        require(expected_b > 0.0, "functional_test.expected_breakaway_nm")?;
-        let expected = l + (1.0 + g) * expected_b;
-        // T_b = p·L + q·C₀ and T_o = L + d·C₀ (d: the pack's drag per C₀ while driving).
-        let drag = m.pack_torque_per_newton_m(finite(m.mu_dynamic, "mechanism.mu_dynamic")?);
-        let d = drag / per_n / (1.0 + drag * m.ramp_factor_per_m());
-        let (p, q) = ((g - 1.0) / (1.0 + g), 1.0 / (1.0 + g));
-        let separation = q - p * d;
-        require(separation > 0.05, "mechanism.mu_dynamic")?;
-        if let Some(o) = t.expected_opening_nm {
-            positive(o, "functional_test.expected_opening_nm")?;
-        }
-        let acceptance = match (t.expected_breakaway_nm, t.expected_opening_nm) {
-            // A spring-only pack drags on its whole spring (d ≈ 0.6…1.2): its two readings move
-            // alike with L and C₀, and the breakaway alone stands (docs/functional-test.md).
-            (Some(b), Some(o)) if c.driving_pack == DrivingPack::Relieved => Some(Acceptance {
-                breakaway: q16(b, "functional_test.expected_breakaway_nm")?,
-                opening: q16(o, "functional_test.expected_opening_nm")?,
-                k_b: q16(1.0 / separation, "mechanism.mu_dynamic")?,
-                k_o: q16(p / separation, "mechanism.mu_dynamic")?,
-                drag: q16(d, "mechanism.mu_dynamic")?,
-                load_error: q16(
-                    l * positive(t.load_tolerance, "functional_test.load_tolerance")?,
-                    "functional_test.load_tolerance",
-                )?,
-            }),
-            (None, Some(_)) => {
-                return Err(ConfigError::OutOfRange {
-                    parameter: "functional_test.expected_opening_nm",
-                })
-            }
-            _ => None,
-        };
-        let open_ticks = ticks(t.open_s, tick_hz(c)?, "functional_test.open_s")?;
-        let push_from =
-            open_ticks.saturating_add(ticks(t.settle_s, tick_hz(c)?, "functional_test.settle_s")?);
-        let margin = positive(t.min_margin, "functional_test.min_margin")?;
-        require(margin <= 1.0, "functional_test.min_margin")?;
-        let top = finite(t.max_margin, "functional_test.max_margin")?;
-        require((1.0..=16.0).contains(&top), "functional_test.max_margin")?;
-        let bits = c.sensors.output_encoder_bits;
-        require((8..=24).contains(&bits), "sensors.output_encoder_bits")?;
-        let counts = positive(t.breakaway_rad, "functional_test.breakaway_rad")?
-            / c.sensors.output_rad_per_count();
-        require(counts < 1e6, "functional_test.breakaway_rad")?;
-        let hz = positive(t.torque_filter_hz, "functional_test.torque_filter_hz")?;
-        let tick_hz = tick_hz(c)?;
-        Ok(TestSettings {
-            judge: TestJudge {
-                sign: if load > 0.0 { 1 } else { -1 },
-                load: q16(l, "functional_test.load_nm")?,
-                lever: q16(1.0 + g, "capacity_mu")?,
-                expected_capacity: q16(expected, "functional_test.expected_breakaway_nm")?,
-                min_capacity: q16(expected * margin, "functional_test.min_margin")?,
-                max_capacity: q16(expected * top, "functional_test.max_margin")?,
-            },
-            companion: acceptance.map_or(Companion::Alone, Companion::Acceptance),
-            measure_from: open_ticks / 2,
-            open_ticks,
-            push_from,
-            limit_ticks: ticks(
-                max / rate + 5.0 / hz,
-                tick_hz,
-                "functional_test.torque_rate_nm_s",
-            )?,
-            // 0 < counts < 1e6 (checked above): the next whole count, at least 1.
-            breakaway_counts: (counts as i32 + 1).max(1),
-            out_bits: bits,
-            alpha: filter_gain(hz, tick_hz, EVERY_TICK, "functional_test.torque_filter_hz")?,
-        })
-    }
-}
-
-/// A loaded-test parameter's name for the uncoupled test (the drive's and shared ones unchanged).
-fn uncoupled_name(p: &'static str) -> &'static str {
-    match p {
-        "functional_test.load_nm" => "uncoupled_test.load_nm",
-        "functional_test.expected_breakaway_nm" => "uncoupled_test.expected_breakaway_nm",
-        "functional_test.expected_opening_nm" => "uncoupled_test.expected_opening_nm",
-        "functional_test.min_margin" => "uncoupled_test.min_margin",
-        "functional_test.max_margin" => "uncoupled_test.max_margin",
-        "functional_test.load_tolerance" => "uncoupled_test.load_tolerance",
-        shared => shared,
-    }
-}
-
-/// The monitor's tick rate, checked.
-fn tick_hz(c: &Config) -> Result<f64, ConfigError> {
-    positive(c.tick_hz, "tick_hz")
 }
 
 /// Where the test stands.
@@ -413,7 +186,8 @@ pub struct TestReport {
     pub load_nm: Q16,
     /// Largest filtered drive torque along the load before breakaway (N·m).
     pub breakaway_torque_nm: Q16,
-    /// Measured holding capacity at the test load `L + (1 + g)·T_b` (N·m).
+    /// Measured holding capacity at the test load (N·m): `L + (1 + g)·T_b` loaded, `L + T_b`
+    /// uncoupled.
     pub capacity_nm: Q16,
     /// Capacity over the expected capacity (1 = as designed or as commissioned).
     pub margin: Q16,
@@ -463,11 +237,15 @@ impl FunctionalTest {
     pub(crate) fn step(
         &mut self,
         s: &TestSettings,
-        judge: &TestJudge,
         x: &Sensed,
         drive_torque: Q16,
         flags: Flags,
     ) -> TestReport {
+        // A state restored onto a configuration without this procedure concludes nothing.
+        let Some(judge) = s.judge(self.procedure()) else {
+            self.abort();
+            return self.report;
+        };
         if self.report.result != TestResult::Running {
             return self.report;
         }
@@ -563,7 +341,7 @@ impl FunctionalTest {
     }
 
     /// Ends a running test with nothing concluded.
-    pub(crate) fn abort(&mut self) {
+    fn abort(&mut self) {
         if self.report.result == TestResult::Running {
             self.report.result = TestResult::Aborted;
         }

@@ -81,7 +81,7 @@ pub fn main(a: &CommissionArgs) -> Result<i32, String> {
         .collect();
     // The loaded push first: the uncoupled one runs on its drive and timing.
     tests.sort_by_key(|((kind, _), _, _)| *kind == Procedure::Uncoupled);
-    if tests.len() > 1 && tests[0].0 .0 == tests[1].0 .0 {
+    if tests.windows(2).any(|w| w[0].0 .0 == w[1].0 .0) {
         return Ok(bad_input(
             "commission",
             "two functional tests of one procedure given: one loaded and one uncoupled at most",
@@ -111,16 +111,16 @@ pub fn main(a: &CommissionArgs) -> Result<i32, String> {
         let mn = |x: Option<f64>| x.map(|v| (v * 1e3).round() / 1e3);
         t.expected_breakaway_nm = mn(t.expected_breakaway_nm);
         t.expected_opening_nm = mn(t.expected_opening_nm);
-        let (b, o) = (
-            t.expected_breakaway_nm.unwrap_or(0.0),
-            t.expected_opening_nm.unwrap_or(0.0),
-        );
+        let b = t.expected_breakaway_nm.unwrap_or(0.0);
+        let opening = t
+            .expected_opening_nm
+            .map_or(String::new(), |o| format!(", opening {o} N·m"));
         match kind {
             Procedure::Loaded => c.config.functional_test = t,
             Procedure::Uncoupled => c.config.uncoupled_test = Some(t),
         }
         test_note += &format!(
-            ", {name} functional test breakaway {b} N·m, opening {o} N·m at {} N·m",
+            ", {name} functional test breakaway {b} N·m{opening} at {} N·m",
             procedure.load_nm
         );
     }

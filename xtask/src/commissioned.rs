@@ -79,7 +79,7 @@ pub fn uncoupled_test_on_firmware() -> Result<(), String> {
     let trace = crate::replay::twin_trace(&healthy)?;
     c.uncoupled_test = Some(
         accept(&trace, c, (Procedure::Uncoupled, &uncoupled), start)?
-            .ok_or("the healthy unit's uncoupled push did not break away")?,
+            .ok_or("the healthy unit's uncoupled push did not pass its acceptance")?,
     );
     pass_then_fail(&[healthy, worn], c, "uncoupled")
 }
