@@ -269,8 +269,8 @@ fn uncoupled_report(
 }
 
 /// With no door load to misjudge, a spring-only pack breaks away at its spring's clamp, as
-/// designed; commissioned, the push passes the healthy unit ±0.05 N·m off and fails a pack worn
-/// by half (docs/functional-test.md, "The uncoupled push").
+/// designed; a worn-out pack is refused at acceptance; commissioned, the push passes the healthy
+/// unit ±0.05 N·m off and fails a pack worn by half (docs/functional-test.md).
 #[test]
 fn the_uncoupled_push_finds_a_worn_spring_only_pack() {
     let mut unit = Config {
@@ -278,16 +278,16 @@ fn the_uncoupled_push_finds_a_worn_spring_only_pack() {
         uncoupled_test: Some(TestConfig::UNCOUPLED),
         ..Config::default()
     };
-    let mut s = test_scene(None, 1.0);
-    s.reading = Reading::Paper;
-    s.load_torque_nm = TestConfig::UNCOUPLED.load_nm;
-    let accepted = dormant::accept(
-        &scene_trace(&s).unwrap(),
-        unit,
-        (Procedure::Uncoupled, &TestConfig::UNCOUPLED),
-        s.test.start_s,
-    )
-    .unwrap();
+    let acceptance = |fault| {
+        let mut s = test_scene(fault, 1.0);
+        s.reading = Reading::Paper;
+        s.load_torque_nm = TestConfig::UNCOUPLED.load_nm;
+        let test = (Procedure::Uncoupled, &TestConfig::UNCOUPLED);
+        dormant::accept(&scene_trace(&s).unwrap(), unit, test, s.test.start_s).unwrap()
+    };
+    // Below the design's floor a unit is not taken as its own reference.
+    assert_eq!(acceptance(Some((FaultKind::PackWear, 1.0))), None);
+    let accepted = acceptance(None);
     let design = uncoupled_report(unit, None, TestConfig::UNCOUPLED.load_nm);
     assert_eq!(
         design.result,
