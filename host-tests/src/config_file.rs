@@ -19,7 +19,7 @@
 //! expected_opening_nm = 24.8     # and its opening torque (needs the breakaway)
 //! min_margin = 0.95
 //! [monitor.uncoupled_test]       # a spring-only pack's push with the output uncoupled (its
-//! expected_breakaway_nm = 8.2    # fields as above; its drive and timing are the loaded test's)
+//! expected_breakaway_nm = 8.2    # fields as above but no opening; drive and timing the loaded's)
 //! [monitor.aiding_braking]       # a spring-only pack's braking (AidingBraking), all three
 //! inertia_kg_m2 = 0.15
 //! drag_nm = 8.4

@@ -81,6 +81,16 @@ pub fn main(a: &CommissionArgs) -> Result<i32, String> {
         .collect();
     // The loaded push first: the uncoupled one runs on its drive and timing.
     tests.sort_by_key(|((kind, _), _, _)| *kind == Procedure::Uncoupled);
+    if tests
+        .first()
+        .is_some_and(|t| t.0 .0 == Procedure::Uncoupled)
+    {
+        // Its acceptance has a floor only: the loaded push judges a dragging pack.
+        return Ok(bad_input(
+            "commission",
+            "the uncoupled push needs the loaded functional_test run beside it",
+        ));
+    }
     if tests.windows(2).any(|w| w[0].0 .0 == w[1].0 .0) {
         return Ok(bad_input(
             "commission",
