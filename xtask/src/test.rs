@@ -342,15 +342,28 @@ fn run_and_monitor_agree_on_time() -> Result<(), String> {
     }
 }
 
-/// The trip log's power-loss test and the replay of a fault scene's records (host side).
+/// The trip log's power-loss test and the replay of a fault scene's records (host side), on
+/// the default configuration and on another, which replays only its own records.
 fn trip_log_holds() -> Result<(), String> {
+    use noback::monitor::Config;
     let code = crate::trip_log::power_fail(&crate::trip_log::PowerFailArgs { json: false })?;
-    let (records, _) = crate::trip_log::record_scene(&fault_scene()?)?;
-    let mut all = code == 0 && !records.is_empty();
-    for bytes in &records {
-        let (same, line) = crate::trip_log::replay(bytes, noback::monitor::Config::default())?;
-        println!("{line}");
-        all &= same;
+    let mut all = code == 0;
+    for config in [Config::default(), Config::physical_reading()] {
+        let (records, _) = crate::trip_log::record_scene(&fault_scene()?, config)?;
+        all &= !records.is_empty();
+        for bytes in &records {
+            let (same, line) = crate::trip_log::replay(bytes, config)?;
+            println!("{line}");
+            all &= same;
+        }
+        let other = if config == Config::default() {
+            Config::physical_reading()
+        } else {
+            Config::default()
+        };
+        all &= records
+            .iter()
+            .all(|b| crate::trip_log::replay(b, other).is_err());
     }
     if all {
         Ok(())

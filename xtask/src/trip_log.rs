@@ -31,6 +31,9 @@ pub enum LogCmd {
         /// Where the region goes (default target/trip-log/SCENE.flash).
         #[arg(long)]
         out: Option<PathBuf>,
+        /// The unit's configuration file (`cargo xtask commission`'s; default: uncommissioned).
+        #[arg(long)]
+        config: Option<PathBuf>,
     },
     /// Decode the records of a flash region.
     Dump {
@@ -47,6 +50,9 @@ pub enum LogCmd {
         /// The record's index in `log dump`'s list.
         #[arg(long, default_value_t = 0)]
         record: usize,
+        /// The configuration the unit ran (its record names its digest; default: uncommissioned).
+        #[arg(long)]
+        config: Option<PathBuf>,
     },
 }
 
@@ -64,7 +70,10 @@ fn store(flash: Flash) -> Result<Store<Flash>, String> {
 /// Entry of `log`.
 pub fn main(a: &LogArgs) -> Result<i32, String> {
     match &a.cmd {
-        LogCmd::Record { scene, out } => record(scene, out.as_ref()),
+        LogCmd::Record { scene, out, config } => match unit_config(config.as_deref()) {
+            Ok(c) => record(scene, out.as_ref(), c),
+            Err(e) => Ok(bad_input("log", &e)),
+        },
         LogCmd::Dump { file, json } => {
             let records = match read(file) {
                 Ok(r) => r,
@@ -89,7 +98,11 @@ pub fn main(a: &LogArgs) -> Result<i32, String> {
             }
             Ok(0)
         }
-        LogCmd::Replay { file, record } => {
+        LogCmd::Replay {
+            file,
+            record,
+            config,
+        } => {
             let records = match read(file) {
                 Ok(r) => r,
                 Err(e) => return Ok(bad_input("log", &e)),
@@ -103,9 +116,15 @@ pub fn main(a: &LogArgs) -> Result<i32, String> {
                     ),
                 ));
             };
-            let (same, line) = replay(bytes, Config::default())?;
-            println!("{line}");
-            Ok(if same { 0 } else { 1 })
+            // A record replays only on the configuration it names (or a corrupt one not at all).
+            let replayed = unit_config(config.as_deref()).and_then(|c| replay(bytes, c));
+            match replayed {
+                Ok((same, line)) => {
+                    println!("{line}");
+                    Ok(if same { 0 } else { 1 })
+                }
+                Err(e) => Ok(bad_input("log", &e)),
+            }
         }
     }
 }
@@ -236,11 +255,17 @@ pub fn report(
     Ok((v, matches && all_exact))
 }
 
-/// The records of a host run of `scene` (a record at each flag change) and the region.
-pub fn record_scene(scene: &str) -> Result<(Vec<Vec<u8>>, Vec<u8>), String> {
+/// A configuration file's monitor, else the uncommissioned defaults.
+fn unit_config(file: Option<&std::path::Path>) -> Result<Config, String> {
+    file.map_or(Ok(Config::default()), crate::monitor::config_from_file)
+}
+
+/// The records of a host run of `scene` on `config` (a record at each flag change) and the
+/// region.
+pub fn record_scene(scene: &str, config: Config) -> Result<(Vec<Vec<u8>>, Vec<u8>), String> {
     let s = noback_twin::cli::load_scene(scene, None)?;
     let trace = host_tests::accuracy::scene_trace(&s)?;
-    let mut monitor = Monitor::new(Config::default()).map_err(|e| format!("{e:?}"))?;
+    let mut monitor = Monitor::new(config).map_err(|e| format!("{e:?}"))?;
     let mut recorder = Recorder::<{ noback::trip_log::RING_INPUTS }>::new();
     let mut st = store(Flash::new(SECTORS))?;
     let mut records = Vec::new();
@@ -262,11 +287,11 @@ pub fn record_scene(scene: &str) -> Result<(Vec<Vec<u8>>, Vec<u8>), String> {
     Ok((records, st.into_flash().bytes))
 }
 
-fn record(scene: &str, out: Option<&PathBuf>) -> Result<i32, String> {
+fn record(scene: &str, out: Option<&PathBuf>, config: Config) -> Result<i32, String> {
     if let Err(e) = noback_twin::cli::load_scene(scene, None) {
         return Ok(bad_input("log", &e));
     }
-    let (records, region) = record_scene(scene)?;
+    let (records, region) = record_scene(scene, config)?;
     let stem = std::path::Path::new(scene)
         .file_stem()
         .map_or("scene".into(), |s| s.to_string_lossy().into_owned());
