@@ -83,10 +83,7 @@ pub fn run_functional_test(
     (kind, test): (Procedure, &TestConfig),
     start_s: f64,
 ) -> Result<TestReport, String> {
-    match kind {
-        Procedure::Loaded => config.functional_test = *test,
-        Procedure::Uncoupled => config.uncoupled_test = Some(*test),
-    }
+    kind.set_test(&mut config, *test);
     let mut monitor = Monitor::new(config).map_err(|e| format!("monitor config: {e:?}"))?;
     let start = (start_s * trace.sample_rate_hz).round() as usize;
     for (i, r) in trace.rows.iter().enumerate() {

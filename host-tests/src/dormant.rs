@@ -128,10 +128,7 @@ pub fn functional_test_after(d: &Draw, config: Config) -> Result<Verdict, String
         let Some(commissioned) = accept(&trace, unit, (*kind, procedure), start)? else {
             return Ok(Verdict::Rejected);
         };
-        match kind {
-            Procedure::Loaded => unit.functional_test = commissioned,
-            Procedure::Uncoupled => unit.uncoupled_test = Some(commissioned),
-        }
+        kind.set_test(&mut unit, commissioned);
     }
     // In service: each procedure at a load within its tolerance, with the run's faults.
     for (kind, procedure, tolerance, rng) in &mut procedures {
@@ -139,11 +136,9 @@ pub fn functional_test_after(d: &Draw, config: Config) -> Result<Verdict, String
         let mut in_service = test_scene(&d.scene, load, &d.scene.faults);
         in_service.noise.seed = rng.next_u64();
         let trace = scene_trace(&in_service)?;
-        let test = match kind {
-            Procedure::Loaded => Some(unit.functional_test),
-            Procedure::Uncoupled => unit.uncoupled_test,
-        }
-        .ok_or("the uncoupled push was not accepted")?;
+        let test = kind
+            .test(&unit)
+            .ok_or("the uncoupled push was not accepted")?;
         if run_functional_test(&trace, unit, (*kind, &test), start)?.result != TestResult::Pass {
             return Ok(Verdict::Fail);
         }

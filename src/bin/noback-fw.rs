@@ -144,7 +144,7 @@ mod target {
             session::run_bench(replay, stream, monitor, peripherals.SYST)
         } else {
             let mut app: App = Ticker::new(monitor, replay, AlarmPin { high: false });
-            app.request_functional_test_at(args.functional_test_at, args.functional_test);
+            app.request_functional_test_at(args.functional_test_at, args.test_procedure);
             run_realtime(
                 app,
                 stream,

@@ -26,6 +26,7 @@
 
 mod settings;
 
+use super::config::Config;
 use super::io::Flags;
 use super::sense::Sensed;
 use crate::fx::{counter_delta, lowpass, Q16};
@@ -150,6 +151,32 @@ pub enum Procedure {
     Uncoupled,
 }
 
+impl Procedure {
+    /// Its name in reports and log lines.
+    pub const fn name(self) -> &'static str {
+        match self {
+            Procedure::Loaded => "loaded",
+            Procedure::Uncoupled => "uncoupled",
+        }
+    }
+
+    /// Its test in `c`, if configured.
+    pub fn test(self, c: &Config) -> Option<TestConfig> {
+        match self {
+            Procedure::Loaded => Some(c.functional_test),
+            Procedure::Uncoupled => c.uncoupled_test,
+        }
+    }
+
+    /// Configures `t` as its test in `c`.
+    pub fn set_test(self, c: &mut Config, t: TestConfig) {
+        match self {
+            Procedure::Loaded => c.functional_test = t,
+            Procedure::Uncoupled => c.uncoupled_test = Some(t),
+        }
+    }
+}
+
 /// Where the test stands.
 #[cfg_attr(
     feature = "config-block",
@@ -241,14 +268,14 @@ impl FunctionalTest {
         drive_torque: Q16,
         flags: Flags,
     ) -> TestReport {
-        // A state restored onto a configuration without this procedure concludes nothing.
-        let Some(judge) = s.judge(self.procedure()) else {
-            self.abort();
-            return self.report;
-        };
         if self.report.result != TestResult::Running {
             return self.report;
         }
+        // A state restored onto a configuration without this procedure concludes nothing.
+        let Some(judge) = s.judge(self.procedure()) else {
+            self.report.result = TestResult::Aborted;
+            return self.report;
+        };
         if flags.fault() {
             self.report.result = TestResult::Aborted;
             return self.report;
@@ -295,8 +322,9 @@ impl FunctionalTest {
     fn decide(&mut self, s: &TestSettings, j: &TestJudge) {
         let r = &mut self.report;
         let t_b = r.breakaway_torque_nm;
-        let acceptance = match (r.procedure, &s.companion) {
-            (Procedure::Loaded, Companion::Acceptance(a)) => Some(a),
+        // An uncoupled push has a judge only beside `Companion::Uncoupled`.
+        let acceptance = match &s.companion {
+            Companion::Acceptance(a) => Some(a),
             _ => None,
         };
         let (capacity, load_ok) = match acceptance {
@@ -338,12 +366,5 @@ impl FunctionalTest {
     /// The procedure requested.
     pub fn procedure(&self) -> Procedure {
         self.report.procedure
-    }
-
-    /// Ends a running test with nothing concluded.
-    fn abort(&mut self) {
-        if self.report.result == TestResult::Running {
-            self.report.result = TestResult::Aborted;
-        }
     }
 }

@@ -30,7 +30,7 @@ pub struct Args {
     /// The tick at which the ground crew requests the functional test (`u32::MAX`: never).
     pub functional_test_at: u32,
     /// Which (`uncoupled-test-at=N` asks for the uncoupled push).
-    pub functional_test: Procedure,
+    pub test_procedure: Procedure,
     path: [u8; PATH_BYTES + 1],
     trip_path: [u8; PATH_BYTES + 1],
     config_path: [u8; PATH_BYTES + 1],
@@ -52,7 +52,7 @@ pub fn args() -> Args {
         overrun_at: u32::MAX,
         reset_every: 0,
         functional_test_at: u32::MAX,
-        functional_test: Procedure::Loaded,
+        test_procedure: Procedure::Loaded,
         path: [0; PATH_BYTES + 1],
         trip_path: [0; PATH_BYTES + 1],
         config_path: [0; PATH_BYTES + 1],
@@ -82,10 +82,10 @@ pub fn args() -> Args {
                 a.reset_every = n.parse().unwrap_or(0);
             } else if let Some(n) = arg.strip_prefix("functional-test-at=") {
                 a.functional_test_at = n.parse().unwrap_or(u32::MAX);
-                a.functional_test = Procedure::Loaded;
+                a.test_procedure = Procedure::Loaded;
             } else if let Some(n) = arg.strip_prefix("uncoupled-test-at=") {
                 a.functional_test_at = n.parse().unwrap_or(u32::MAX);
-                a.functional_test = Procedure::Uncoupled;
+                a.test_procedure = Procedure::Uncoupled;
             }
         }
     }

@@ -98,10 +98,7 @@ pub fn main(a: &CommissionArgs) -> Result<i32, String> {
         ));
     }
     for ((kind, procedure), trace, scene) in tests {
-        let name = match kind {
-            Procedure::Loaded => "loaded",
-            Procedure::Uncoupled => "uncoupled",
-        };
+        let name = kind.name();
         if kind == Procedure::Uncoupled && c.config.driving_pack != DrivingPack::SpringOnly {
             return Ok(bad_input(
                 "commission",
@@ -125,10 +122,7 @@ pub fn main(a: &CommissionArgs) -> Result<i32, String> {
         let opening = t
             .expected_opening_nm
             .map_or(String::new(), |o| format!(", opening {o} N·m"));
-        match kind {
-            Procedure::Loaded => c.config.functional_test = t,
-            Procedure::Uncoupled => c.config.uncoupled_test = Some(t),
-        }
+        kind.set_test(&mut c.config, t);
         test_note += &format!(
             ", {name} functional test breakaway {b} N·m{opening} at {} N·m",
             procedure.load_nm

@@ -12,7 +12,6 @@ use host_tests::accuracy::{
     scene_trace, Accuracy, COMPARE_WINDOW_S,
 };
 use host_tests::mc::not_driven;
-use noback::monitor::functional_test::Procedure;
 use noback::monitor::Config;
 use noback::sensors::SensorConfig;
 use noback_twin::fault::Fault;
@@ -62,14 +61,12 @@ fn functional_test_json(
 ) -> Result<serde_json::Value, String> {
     let (kind, test) = host_tests::dormant::procedure_of(scene);
     let config = crate::run::test_configuration(config, kind, test)?;
-    let test = match kind {
-        Procedure::Loaded => Some(config.functional_test),
-        Procedure::Uncoupled => config.uncoupled_test,
-    }
-    .ok_or("the configuration has no uncoupled push")?;
+    let test = kind
+        .test(&config)
+        .ok_or("the configuration has no uncoupled push")?;
     let r = run_functional_test(trace, config, (kind, &test), scene.test.start_s)?;
     Ok(json!({
-        "procedure": format!("{:?}", r.procedure).to_lowercase(),
+        "procedure": r.procedure.name(),
         "result": format!("{:?}", r.result).to_lowercase(),
         "opening_torque_nm": r.opening_torque_nm.to_num::<f64>(),
         "breakaway_torque_nm": r.breakaway_torque_nm.to_num::<f64>(),

@@ -382,7 +382,7 @@ pub fn replay_report_with(
             });
             let milli = |q: noback::fx::Q16| (q.to_num::<f64>() * 1e3).round() / 1e3;
             let same = result == format!("{:?}", h.result).to_lowercase()
-                && procedure == format!("{:?}", h.procedure).to_lowercase()
+                && procedure == h.procedure.name()
                 && (num("opening_nm")? - milli(h.opening_torque_nm)).abs() < 1.5e-3
                 && (num("breakaway_nm")? - milli(h.breakaway_torque_nm)).abs() < 1.5e-3
                 && (num("margin")? - milli(h.margin)).abs() < 1.5e-3;
