@@ -440,9 +440,10 @@ impl State {
             k.refresh_load(&mut self.load);
         }
         // The pack's torque is known against an opposing load only where both socket faces
-        // clamp (`learn_opposed`), not on a guessed sign (`alt`), nor where the pack engages is
-        // unknown (an input that ran ahead, a spring-only pack's turn-back).
+        // clamp (`learn_opposed`), not on a guessed sign (`alt`) or an unseen load, nor where
+        // the pack engages is unknown (an input that ran ahead, a spring-only pack's turn-back).
         let learnable = self.load.decided()
+            && !self.load.unseen()
             && (k.load.learn_opposed || c.load_along)
             && self.classify.engagement_known(&k.scene);
         if moving_ok && !x.drive && learnable {

@@ -53,6 +53,9 @@ pub const BRAKING_SHARE_MARGIN: f64 = 0.8;
 pub const MIN_LOAD_SPAN_NM: f64 = 5.0;
 /// Plausible range of the identified gain (measured drive torque over true).
 pub const GAIN_RANGE: (f64, f64) = (0.5, 2.0);
+/// The least `a·k` a relieved pack's closings can be read at: the bound of the band around 1
+/// that `Monitor::new` refuses without a measured overrunning line.
+pub const MIN_SELF_LOCKING: f64 = 1.05;
 
 /// What one acceptance run showed.
 #[derive(Clone, Debug, PartialEq)]
@@ -159,7 +162,13 @@ fn measure(
             base.thresholds.min_load_nm * 2.0
         ));
     }
-    let estimates = run_monitor(trace, base)?;
+    // Health is judged by the uncommissioned monitor, on the design's pack: a build record's
+    // pack with the design's friction may be one `Monitor::new` refuses.
+    let design = Config {
+        mechanism: Config::default().mechanism,
+        ..base
+    };
+    let estimates = run_monitor(trace, design)?;
     let dt = 1.0 / trace.sample_rate_hz;
     if let Some((i, e)) = estimates
         .iter()
@@ -266,6 +275,11 @@ fn measure(
 /// [`MIN_LOAD_SPAN_NM`] apart: the gain is the slope of drive torque over load. A run that cannot
 /// identify them is refused with the reason (naming the run when there are several).
 pub fn commission(runs: &[(&Trace, f64)]) -> Result<Commissioning, String> {
+    commission_with(runs, Config::default())
+}
+
+/// [`commission`] from `base` (the unit's as-built mechanism in place of the design's).
+pub fn commission_with(runs: &[(&Trace, f64)], base: Config) -> Result<Commissioning, String> {
     let name = |i: usize| {
         if runs.len() > 1 {
             format!("run {}: ", i + 1)
@@ -276,7 +290,7 @@ pub fn commission(runs: &[(&Trace, f64)]) -> Result<Commissioning, String> {
     let first = runs.first().ok_or("no acceptance run")?;
     // The offset first (drive off in the hold, once the run checked out), so the drive torques
     // are read without it.
-    let mut base = Config::default();
+    let mut base = base;
     let first = measure(first.0, first.1, base, None).map_err(|e| name(0) + &e)?;
     base.current_offset_a = first.hold_current_a;
     let dir = Some(first.drive_speed_rad_s.signum());
@@ -357,6 +371,14 @@ pub fn commission(runs: &[(&Trace, f64)]) -> Result<Commissioning, String> {
         (true, None) => overrun_line(&closings, gain)?,
         (false, _) => None,
     };
+    // The closing estimate reads the load off `1/(a·k − 1)`: a relieved pack that barely
+    // self-locks while slipping, or does not, is refused (Monitor::new's bound).
+    let a_k = overrun.map_or(a * k, |l| l.gain / (l.gain - 2.0));
+    if relieved && a_k < MIN_SELF_LOCKING {
+        return Err(format!(
+            "the runs give a·k = {a_k:.3}: a pack that self-locks too little while slipping for its closings to be read (a·k ≥ {MIN_SELF_LOCKING})"
+        ));
+    }
     let braking_share = heaviest.braking_share;
     let aiding = (!relieved)
         .then(|| aiding_braking(&opening, closing?, base.mechanism.output_inertia_kg_m2))
@@ -506,6 +528,16 @@ pub fn commission_unit(
     plan: &[(SceneKind, f64)],
     installed: impl Fn(&mut Trace),
 ) -> Result<Commissioning, String> {
+    commission_unit_with(scene, plan, installed, Config::default())
+}
+
+/// [`commission_unit`] from `base` ([`commission_with`]).
+pub fn commission_unit_with(
+    scene: &Scene,
+    plan: &[(SceneKind, f64)],
+    installed: impl Fn(&mut Trace),
+    base: Config,
+) -> Result<Commissioning, String> {
     let mut traces = Vec::new();
     for &(kind, load) in plan {
         let mut run = scene.clone();
@@ -520,5 +552,5 @@ pub fn commission_unit(
         traces.push((trace, load));
     }
     let runs: Vec<_> = traces.iter().map(|(t, l)| (t, *l)).collect();
-    commission(&runs)
+    commission_with(&runs, base)
 }

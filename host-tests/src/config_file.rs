@@ -13,6 +13,9 @@
 //! motor_torque_constant_nm_a = 0.066
 //! [monitor.thresholds]
 //! opposed_braking_share = 1.0
+//! [monitor.mechanism]            # the unit's build record (host_tests::as_built), over Table 2
+//! spring_preload_m = 2.41e-3
+//! socket_chamfer_rad = 0.80
 //! [monitor.functional_test]      # the commanded test's procedure (TestConfig's fields)
 //! load_nm = 20.3
 //! expected_breakaway_nm = 11.0   # the unit's acceptance test (absent: the design's)
@@ -175,6 +178,10 @@ pub fn parse(text: &str) -> Result<Config, String> {
     if let Some(t) = m.remove("thresholds") {
         c.thresholds = thresholds(c.thresholds, table(t, "monitor.thresholds")?)?;
     }
+    if let Some(t) = m.remove("mechanism") {
+        let t = table(t, "monitor.mechanism")?;
+        c.mechanism = crate::as_built::mechanism_table(&c.mechanism, t)?;
+    }
     if let Some(t) = m.remove("functional_test") {
         let path = "monitor.functional_test";
         c.functional_test = test_table(table(t, path)?, TestConfig::DEFAULT, path)?;
@@ -284,6 +291,11 @@ pub fn write(c: &Config, comment: &str) -> Result<String, String> {
             }
         }
     }
+    let mechanism = crate::as_built::mechanism_lines(&Config::default().mechanism, &c.mechanism);
+    if !mechanism.is_empty() {
+        out.push_str("[monitor.mechanism]\n");
+        out.push_str(&mechanism);
+    }
     let test = test_lines(TestConfig::DEFAULT, c.functional_test);
     if !test.is_empty() {
         out.push_str("[monitor.functional_test]\n");
@@ -342,6 +354,7 @@ mod tests {
         c.sliding_mu = 0.2345678901;
         c.driving_pack = DrivingPack::SpringOnly;
         c.thresholds.creep_limit_rad = 0.125;
+        c.mechanism = crate::as_built::AsBuilt::inspected(&c.mechanism, 7).applied_to(&c.mechanism);
         c.functional_test = TestConfig {
             load_nm: 18.5,
             ..TestConfig::DEFAULT
@@ -386,6 +399,14 @@ mod tests {
                 "opposed_braking_share",
             ),
             ("[other]\n", "[monitor]"),
+            (
+                "[monitor.mechanism]\nmu_static = 0.3\n",
+                "monitor.mechanism.mu_static",
+            ),
+            (
+                "[monitor.mechanism]\npack_inner_radius_m = 0.04\n",
+                "mechanism.pack_outer_radius_m",
+            ),
             (
                 "[monitor.functional_test]\nload = 1\n",
                 "monitor.functional_test.load",

@@ -6,6 +6,7 @@
 //! monitor and the twin, which know nothing of each other.
 
 pub mod accuracy;
+pub mod as_built;
 pub mod commission;
 pub mod config_file;
 pub mod dormant;

@@ -437,3 +437,15 @@ fn a_light_opening_load_is_read_at_its_late_lock() {
     }
     assert_eq!((openings, closings), (6, 6));
 }
+
+/// A relieved pack that barely self-locks while slipping (`a·k` ≈ 0.95 in the twin, a draw the
+/// plant family makes) is refused: its closings' load would be read off `1/(a·k − 1)`.
+#[test]
+fn a_pack_that_barely_self_locks_while_slipping_is_refused() {
+    let mut unit = Scene::builtin(SceneKind::ReverseLoad, Reading::Physical);
+    let m = &unit.mechanism;
+    let a_k = m.pack_torque_per_newton_m(m.mu_dynamic) * m.ramp_factor_per_m();
+    unit.mechanism.mu_dynamic *= 0.95 / a_k;
+    let e = commission_unit(&unit, &ACCEPTANCE, |_| {}).unwrap_err();
+    assert!(e.contains("self-locks too little"), "{e}");
+}

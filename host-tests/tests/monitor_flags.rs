@@ -275,6 +275,22 @@ fn constructor_rejects_out_of_range_parameters() {
             parameter: "mechanism.output_inertia_kg_m2"
         }
     );
+    // a·k = μ_d·c·tanθ/r at 1: the model's overrunning line divides by a·k − 1, a measured
+    // line does not.
+    let mut c = Config::physical_reading();
+    c.sliding_mu =
+        1.0 / (c.mechanism.pack_torque_per_newton_m(1.0) * c.mechanism.ramp_factor_per_m());
+    assert_eq!(
+        err(c),
+        ConfigError::OutOfRange {
+            parameter: "sliding_mu"
+        }
+    );
+    c.overrun_line = Some(noback::monitor::OverrunLine {
+        gain: 6.9,
+        offset_nm: 11.6,
+    });
+    assert!(Monitor::new(c).is_ok());
     let mut c = Config::physical_reading();
     c.sensors.reducer_efficiency = 1.2;
     assert_eq!(

@@ -259,8 +259,8 @@ impl Load {
         self.cache_health();
     }
 
-    /// The load is known and its sign is not a power-on guess (`alt`): what the pack-health
-    /// learning counts on (trust also needs the load seen, [`Load::trusted`]).
+    /// The load is known and its sign is not a power-on guess (`alt`) (trust also needs the
+    /// load seen, [`Load::trusted`]; the pack-health learning too).
     pub fn decided(&self) -> bool {
         self.estimate.known().is_some() && self.alt.is_none()
     }

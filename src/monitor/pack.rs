@@ -101,7 +101,6 @@ impl PackSettings {
         // a·k = μ_d·c·tanθ/r (1.42 at Table 2): the overrunning equilibrium divides by a·k − 1.
         let a = m.pack_torque_per_newton_m(mu_d);
         let a_k = a * ramp;
-        require(!(a_k > 0.95 && a_k < 1.05), "sliding_mu")?;
         let drive_force = match c.driving_pack {
             DrivingPack::Relieved => spring / (1.0 + a_k),
             DrivingPack::SpringOnly => spring,
@@ -128,6 +127,12 @@ impl PackSettings {
                     (offset, "overrun_line.offset_nm"),
                     gain / (gain - 2.0),
                 )
+            }
+            // The model's line divides by a·k − 1: refused near 1 (a measured line is not).
+            None if a_k > 0.95 && a_k < 1.05 => {
+                return Err(ConfigError::OutOfRange {
+                    parameter: "sliding_mu",
+                })
             }
             None => (
                 (2.0 * a_k / (a_k - 1.0), "sliding_mu"),

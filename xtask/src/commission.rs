@@ -1,11 +1,12 @@
-//! `cargo xtask commission RUN [RUN…] [--load-nm L]… [--out FILE] [--json]` — the unit's
+//! `cargo xtask commission RUN [RUN…] [--load-nm L]… [--as-built FILE] [--out FILE] [--json]` — the unit's
 //! settings from its recorded acceptance runs (`host_tests::commission`), written as the
 //! monitor's configuration file (`host_tests::config_file`).
 
 use crate::replay::trace_of;
+use host_tests::as_built::AsBuilt;
 use host_tests::dormant::{accept, procedure_of};
 use noback::monitor::functional_test::Procedure;
-use noback::monitor::DrivingPack;
+use noback::monitor::{Config, DrivingPack};
 use noback_twin::args::bad_input;
 use noback_twin::scene::SceneKind;
 use noback_twin::trace::Trace;
@@ -26,6 +27,11 @@ pub struct CommissionArgs {
     /// required for a trace.
     #[arg(long, value_name = "NM", allow_hyphen_values = true)]
     pub load_nm: Vec<f64>,
+    /// The unit's build record (`[as_built]`: spring_preload_n, socket_radius_m,
+    /// socket_chamfer_rad, pack_inner_radius_m, pack_outer_radius_m): the pack's model is set from
+    /// it in place of Table 2's (docs/commissioning.md, "The build record").
+    #[arg(long, value_name = "FILE")]
+    pub as_built: Option<PathBuf>,
     /// Where the configuration file goes (default: printed).
     #[arg(long, value_name = "FILE")]
     pub out: Option<PathBuf>,
@@ -69,8 +75,18 @@ pub fn main(a: &CommissionArgs) -> Result<i32, String> {
         };
         runs.push((trace, load));
     }
+    let mut base = Config::default();
+    if let Some(path) = &a.as_built {
+        let record = std::fs::read_to_string(path)
+            .map_err(|e| e.to_string())
+            .and_then(|text| AsBuilt::parse(&text));
+        match record {
+            Ok(r) => base.mechanism = r.applied_to(&base.mechanism),
+            Err(e) => return Ok(bad_input("commission", &format!("{}: {e}", path.display()))),
+        }
+    }
     let pairs: Vec<(&Trace, f64)> = runs.iter().map(|(t, l)| (t, *l)).collect();
-    let mut c = match host_tests::commission::commission(&pairs) {
+    let mut c = match host_tests::commission::commission_with(&pairs, base) {
         Ok(c) => c,
         Err(e) => return Ok(bad_input("commission", &e)),
     };
@@ -137,7 +153,10 @@ pub fn main(a: &CommissionArgs) -> Result<i32, String> {
         c.gain,
         c.drive_drag_nm,
         c.braking_share
-    ) + &test_note;
+    ) + &test_note
+        + &a.as_built.as_ref().map_or(String::new(), |p| {
+            format!(", build record {}", noback_twin::args::short(&p.to_string_lossy()))
+        });
     let text = host_tests::config_file::write(&c.config, &comment)?;
     if let Some(path) = &a.out {
         std::fs::write(path, &text).map_err(|e| format!("{}: {e}", path.display()))?;

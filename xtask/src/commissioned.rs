@@ -8,7 +8,7 @@ use noback::monitor::functional_test::{Procedure, TestConfig};
 use noback::monitor::{Config, DrivingPack};
 
 /// The paper reading's reverse_load commissioned from itself (a spring-only pack, another
-/// form than the defaults'), its configuration handed to the firmware as a block: the firmware
+/// form than the defaults') with its build record, its configuration handed to the firmware as a block: the firmware
 /// must say it runs on the block and stay bit-exact with the host on the same configuration,
 /// whose estimates differ from the uncommissioned ones (on the STM32F405 the block sits in its
 /// configuration sector, as commissioning writes it).
@@ -18,7 +18,11 @@ pub fn block_is_bit_exact(core: Core) -> Result<(), String> {
         "[scene]\nkind = \"reverse_load\"\nreading = \"paper\"\n",
     )?;
     let trace = crate::replay::twin_trace(&scene)?;
-    let c = host_tests::commission::commission(&[(&trace, 20.3)])?;
+    // With a build record (as inspection measures a Table 2 unit): the block carries its model.
+    let mut base = Config::default();
+    let record = host_tests::as_built::AsBuilt::inspected(&base.mechanism, 1);
+    base.mechanism = record.applied_to(&base.mechanism);
+    let c = host_tests::commission::commission_with(&[(&trace, 20.3)], base)?;
     let (report, ok) = run::replay_report_with(&scene, core, None, None, false, Some(c.config))?;
     let uncommissioned =
         crate::replay::host_run(&crate::replay::nbr1(&trace)?, &[], None, Config::default())?;

@@ -314,6 +314,11 @@ fn commission_refuses_runs_that_cannot_identify_the_settings() {
         ],
         "one per run",
     );
+    let record = file("record.toml", "[as_built]\nspring_preload_n = 170.0\n");
+    refused(
+        &["commission", "reverse_load", "--as-built", &record],
+        "as_built.socket_radius_m: missing",
+    );
     refused(
         &["run", "--config", "/nonexistent.toml"],
         "nonexistent.toml",

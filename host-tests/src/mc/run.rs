@@ -180,10 +180,19 @@ pub fn evaluate(d: &Draw, campaign: &Campaign) -> Outcome {
 }
 
 /// A draw's unit commissioned on the acceptance procedure ([`crate::commission::ACCEPTANCE`])
-/// of its healthy plant, its sensors mounted as the draw's.
+/// of its healthy plant, its sensors mounted as the draw's, from its build record as inspection
+/// measured it ([`crate::as_built::AsBuilt::inspected`], drawn apart from the run's draws).
 pub fn commission_draw(d: &Draw) -> Result<crate::commission::Commissioning, String> {
-    crate::commission::commission_unit(&d.scene, &crate::commission::ACCEPTANCE, |t| d.mount(t))
+    let record =
+        crate::as_built::AsBuilt::inspected(&d.scene.mechanism, d.scene.noise.seed ^ RECORD_STREAM);
+    let mut base = Config::default();
+    base.mechanism = record.applied_to(&base.mechanism);
+    let plan = &crate::commission::ACCEPTANCE;
+    crate::commission::commission_unit_with(&d.scene, plan, |t| d.mount(t), base)
 }
+
+/// Mixed into a draw's noise seed to draw its build record's inspection errors.
+const RECORD_STREAM: u64 = 0x6275_696c_7420_7265;
 
 /// Runs every draw on `threads` workers, calling `progress(done, total)` as runs finish.
 pub fn run_all(

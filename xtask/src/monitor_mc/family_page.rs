@@ -222,7 +222,10 @@ pub fn main(a: &FamilyArgs) -> Result<(), String> {
          - *Uncommissioned*: the shipped `Config::default()`. *Commissioned*: each drawn unit \
          is first taken, healthy, through the acceptance procedure on the twin \
          (`host_tests::commission::ACCEPTANCE`: openings against 20.3 and 8 N·m, closings \
-         with 20.3 and 5 N·m; commissioning.md) and runs on what commissioning identified; a unit \
+         with 20.3 and 5 N·m), its pack modelled from its build record as inspection measures it \
+         (`host_tests::as_built`: the spring's preload within 2 %, the ramps' chamfer within \
+         0.25°, the radii within 0.5 %; commissioning.md, \"The build record\"), and runs on \
+         what commissioning identified; a unit \
          acceptance refuses runs uncommissioned, counted in the row so named.\n\
          - Cells: detected within 50 ms / manifested, or false alarms / nominal runs, with the \
          two-sided 95 % Clopper–Pearson interval (false alarms: its upper bound per run); after \

@@ -1,0 +1,191 @@
+//! A unit's build record (docs/commissioning.md, "The build record"): what its assembly and
+//! inspection measured of the pack — the spring's preload force and the ramps' and discs'
+//! geometry — which commissioning sets the monitor's mechanism from in place of Table 2's.
+
+use noback::mechanism::Mechanism;
+use noback_twin::sensing::Rng;
+use toml::{Table, Value};
+
+/// The measured quantities, in the record file's keys.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct AsBuilt {
+    /// The spring's preload force as shimmed at assembly (N): `k_t·(x₀ − g_p2)`.
+    pub spring_preload_n: f64,
+    /// `r`, the ball sockets' radius (m).
+    pub socket_radius_m: f64,
+    /// `θ`, the sockets' chamfer (rad).
+    pub socket_chamfer_rad: f64,
+    /// `r1`, `r2`, the friction contact's radii (m).
+    pub pack_inner_radius_m: f64,
+    pub pack_outer_radius_m: f64,
+}
+
+/// The inspection's tolerances the Monte Carlo draws a record within (uniform, ±): the preload
+/// on the shimming fixture's load cell 2 %, the chamfer on a CMM 0.25°, the radii 0.5 %.
+pub const PRELOAD_TOLERANCE: f64 = 0.02;
+pub const CHAMFER_TOLERANCE_RAD: f64 = 0.25 * core::f64::consts::PI / 180.0;
+pub const RADIUS_TOLERANCE: f64 = 0.005;
+
+/// The monitor's mechanism fields a record sets, in the configuration file's keys.
+fn fields(m: &mut Mechanism) -> [(&'static str, &mut f64); 5] {
+    [
+        ("spring_preload_m", &mut m.spring_preload_m),
+        ("socket_radius_m", &mut m.socket_radius_m),
+        ("socket_chamfer_rad", &mut m.socket_chamfer_rad),
+        ("pack_inner_radius_m", &mut m.pack_inner_radius_m),
+        ("pack_outer_radius_m", &mut m.pack_outer_radius_m),
+    ]
+}
+
+impl AsBuilt {
+    /// The record of a mechanism measured exactly.
+    pub fn of(m: &Mechanism) -> AsBuilt {
+        AsBuilt {
+            spring_preload_n: m.spring_preload_n(),
+            socket_radius_m: m.socket_radius_m,
+            socket_chamfer_rad: m.socket_chamfer_rad,
+            pack_inner_radius_m: m.pack_inner_radius_m,
+            pack_outer_radius_m: m.pack_outer_radius_m,
+        }
+    }
+
+    /// The record of `m` as inspection measures it: each quantity within its tolerance, drawn
+    /// from `seed` alone (a draw's other quantities are not moved).
+    pub fn inspected(m: &Mechanism, seed: u64) -> AsBuilt {
+        let mut rng = Rng::new(seed);
+        let mut within = |x: f64, tol: f64| x + tol * (2.0 * rng.uniform() - 1.0);
+        let exact = AsBuilt::of(m);
+        AsBuilt {
+            spring_preload_n: exact.spring_preload_n * within(1.0, PRELOAD_TOLERANCE),
+            socket_radius_m: exact.socket_radius_m * within(1.0, RADIUS_TOLERANCE),
+            socket_chamfer_rad: within(exact.socket_chamfer_rad, CHAMFER_TOLERANCE_RAD),
+            pack_inner_radius_m: exact.pack_inner_radius_m * within(1.0, RADIUS_TOLERANCE),
+            pack_outer_radius_m: exact.pack_outer_radius_m * within(1.0, RADIUS_TOLERANCE),
+        }
+    }
+
+    /// `design` with the record's quantities: the preload force through the design's spring
+    /// stiffness and pack clearance.
+    pub fn applied_to(&self, design: &Mechanism) -> Mechanism {
+        let mut m = *design;
+        m.spring_preload_m = m.pack_clearance_m + self.spring_preload_n / m.spring_stiffness_n_m;
+        m.socket_radius_m = self.socket_radius_m;
+        m.socket_chamfer_rad = self.socket_chamfer_rad;
+        m.pack_inner_radius_m = self.pack_inner_radius_m;
+        m.pack_outer_radius_m = self.pack_outer_radius_m;
+        m
+    }
+
+    /// Reads a record file: `[as_built]` with every key of [`AsBuilt`]; a missing, unknown or
+    /// non-numeric key is an error naming it.
+    pub fn parse(text: &str) -> Result<AsBuilt, String> {
+        let mut root: Table = text
+            .parse()
+            .map_err(|e: toml::de::Error| format!("TOML: {}", e.message()))?;
+        let mut t = match root.remove("as_built") {
+            Some(Value::Table(t)) => t,
+            Some(_) => return Err("as_built: expected a table".into()),
+            None => return Err("[as_built]: missing".into()),
+        };
+        if let Some(k) = root.keys().next() {
+            return Err(format!("{k}: unknown key"));
+        }
+        let mut take = |key: &str| -> Result<f64, String> {
+            match t.remove(key) {
+                Some(Value::Float(x)) if x.is_finite() && x > 0.0 => Ok(x),
+                Some(Value::Integer(i)) if i > 0 => Ok(i as f64),
+                Some(_) => Err(format!("as_built.{key}: expected a positive number")),
+                None => Err(format!("as_built.{key}: missing")),
+            }
+        };
+        let record = AsBuilt {
+            spring_preload_n: take("spring_preload_n")?,
+            socket_radius_m: take("socket_radius_m")?,
+            socket_chamfer_rad: take("socket_chamfer_rad")?,
+            pack_inner_radius_m: take("pack_inner_radius_m")?,
+            pack_outer_radius_m: take("pack_outer_radius_m")?,
+        };
+        match t.keys().next() {
+            Some(k) => Err(format!("as_built.{k}: unknown key")),
+            None => Ok(record),
+        }
+    }
+}
+
+/// The configuration file's `[monitor.mechanism]` over `design`: the keys a record sets.
+pub fn mechanism_table(design: &Mechanism, mut given: Table) -> Result<Mechanism, String> {
+    let mut m = *design;
+    for (key, field) in fields(&mut m) {
+        if let Some(v) = given.remove(key) {
+            *field = match v {
+                Value::Float(x) => x,
+                Value::Integer(i) => i as f64,
+                _ => return Err(format!("monitor.mechanism.{key}: expected a number")),
+            };
+        }
+    }
+    match given.keys().next() {
+        Some(k) => Err(format!("monitor.mechanism.{k}: unknown key")),
+        None => Ok(m),
+    }
+}
+
+/// `[monitor.mechanism]`'s lines: the keys whose value differs from `design`'s.
+pub fn mechanism_lines(design: &Mechanism, m: &Mechanism) -> String {
+    let (mut design, mut m) = (*design, *m);
+    fields(&mut design)
+        .into_iter()
+        .zip(fields(&mut m))
+        .filter(|((_, d), (_, v))| d != v)
+        .map(|((key, _), (_, v))| format!("{key} = {:?}\n", *v))
+        .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use noback::mechanism::TABLE2;
+
+    #[test]
+    fn a_record_of_the_design_is_the_design_and_inspection_stays_within_tolerance() {
+        let exact = AsBuilt::of(&TABLE2).applied_to(&TABLE2);
+        assert!((exact.spring_preload_m - TABLE2.spring_preload_m).abs() < 1e-15);
+        for seed in 0..200 {
+            let r = AsBuilt::inspected(&TABLE2, seed);
+            let f = r.spring_preload_n / TABLE2.spring_preload_n() - 1.0;
+            assert!(f.abs() <= PRELOAD_TOLERANCE, "seed {seed}: preload {f}");
+            let c = r.socket_chamfer_rad - TABLE2.socket_chamfer_rad;
+            assert!(c.abs() <= CHAMFER_TOLERANCE_RAD, "seed {seed}: chamfer {c}");
+            let m = r.applied_to(&TABLE2);
+            assert!((m.spring_preload_n() / r.spring_preload_n - 1.0).abs() < 1e-12);
+        }
+        assert_ne!(
+            AsBuilt::inspected(&TABLE2, 1),
+            AsBuilt::inspected(&TABLE2, 2)
+        );
+    }
+
+    #[test]
+    fn a_record_file_reads_every_key_and_names_a_bad_one() {
+        let good = "[as_built]\nspring_preload_n = 180.0\nsocket_radius_m = 0.0201\n\
+                    socket_chamfer_rad = 0.80\npack_inner_radius_m = 0.0285\npack_outer_radius_m = 0.0375\n";
+        let r = AsBuilt::parse(good).expect("a whole record");
+        assert_eq!(r.spring_preload_n, 180.0);
+        assert_eq!(r.socket_chamfer_rad, 0.80);
+        let missing = good.replace("socket_radius_m = 0.0201\n", "");
+        assert_eq!(
+            AsBuilt::parse(&missing),
+            Err("as_built.socket_radius_m: missing".into())
+        );
+        let extra = format!("{good}mu_static = 0.3\n");
+        assert_eq!(
+            AsBuilt::parse(&extra),
+            Err("as_built.mu_static: unknown key".into())
+        );
+        let negative = good.replace("180.0", "-180.0");
+        assert_eq!(
+            AsBuilt::parse(&negative),
+            Err("as_built.spring_preload_n: expected a positive number".into())
+        );
+    }
+}
