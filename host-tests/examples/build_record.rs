@@ -11,10 +11,9 @@
 use host_tests::accuracy::{compare, run_monitor, Accuracy, Braking};
 use host_tests::as_built::AsBuilt;
 use host_tests::commission::{commission_unit, commission_unit_with, ACCEPTANCE};
-use host_tests::family::{form, runs_and_seed, Family};
-use host_tests::mc::{commission_draw, draw_in, draw_trace, not_driven};
+use host_tests::family::{form, runs_and_seed};
+use host_tests::mc::{braking_draws, commission_draw};
 use noback::monitor::Config;
-use noback_twin::scene::SceneKind;
 use noback_twin::trace::Trace;
 use std::collections::BTreeMap;
 
@@ -40,18 +39,8 @@ fn main() -> Result<(), String> {
     let (runs, seed) = runs_and_seed(&mut args, 1000, 1616);
     let exact = args.next().as_deref() == Some("exact");
     let mut rows: BTreeMap<String, [[usize; 5]; 2]> = BTreeMap::new();
-    for i in 0..runs {
-        let d = draw_in(Family::Plant, seed, i, None);
-        if !matches!(
-            d.scene.kind,
-            SceneKind::ReverseLoad | SceneKind::ForwardLoad
-        ) {
-            continue;
-        }
-        let trace = draw_trace(&d)?;
-        if not_driven(&trace, &d.scene.sensors) {
-            continue;
-        }
+    for draw in braking_draws(seed, runs) {
+        let (i, d, trace) = draw?;
         let recorded = if exact {
             let mut base = Config::default();
             base.mechanism = AsBuilt::of(&d.scene.mechanism).applied_to(&base.mechanism);

@@ -11,9 +11,8 @@
 //! (defaults 2000, 1616).
 
 use host_tests::accuracy::{compare, run_monitor, Accuracy};
-use host_tests::family::{form, runs_and_seed, Family};
-use host_tests::mc::{commission_draw, draw_in, draw_trace, not_driven};
-use noback_twin::scene::SceneKind;
+use host_tests::family::{form, runs_and_seed};
+use host_tests::mc::{braking_draws, commission_draw};
 use noback_twin::trace::Trace;
 use std::collections::BTreeMap;
 
@@ -84,18 +83,8 @@ fn main() -> Result<(), String> {
     let mut args = std::env::args().skip(1);
     let (runs, seed) = runs_and_seed(&mut args, 2000, 1616);
     let mut by: BTreeMap<String, Tally> = BTreeMap::new();
-    for i in 0..runs {
-        let d = draw_in(Family::Plant, seed, i, None);
-        if !matches!(
-            d.scene.kind,
-            SceneKind::ReverseLoad | SceneKind::ForwardLoad
-        ) {
-            continue;
-        }
-        let trace = draw_trace(&d)?;
-        if not_driven(&trace, &d.scene.sensors) {
-            continue;
-        }
+    for draw in braking_draws(seed, runs) {
+        let (_, d, trace) = draw?;
         let Ok(unit) = commission_draw(&d) else {
             continue;
         };

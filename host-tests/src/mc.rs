@@ -370,6 +370,27 @@ pub fn draw_trace(d: &Draw) -> Result<Trace, String> {
     draw_trace_after(d, PRE_ROLL_S)
 }
 
+/// The healthy braking draws (reverse_load, forward_load) among the first `runs` of the plant
+/// family at `seed` that drive, each with its index and [`draw_trace`].
+pub fn braking_draws(
+    seed: u64,
+    runs: u64,
+) -> impl Iterator<Item = Result<(u64, Draw, Trace), String>> {
+    (0..runs).filter_map(move |i| {
+        let d = draw_in(Family::Plant, seed, i, None);
+        if !matches!(
+            d.scene.kind,
+            SceneKind::ReverseLoad | SceneKind::ForwardLoad
+        ) {
+            return None;
+        }
+        match draw_trace(&d) {
+            Ok(t) if not_driven(&t, &d.scene.sensors) => None,
+            trace => Some(trace.map(|t| (i, d, t))),
+        }
+    })
+}
+
 /// The scene the twin runs for a draw whose monitor is powered on `pre_roll_s` into the run:
 /// longer by the pre-roll, its cut and fault onsets shifted by it (twin time).
 pub fn scene_after(d: &Draw, pre_roll_s: f64) -> Scene {
