@@ -372,7 +372,7 @@ pub fn commission_with(runs: &[(&Trace, f64)], base: Config) -> Result<Commissio
         (false, _) => None,
     };
     // The closing estimate reads the load off `1/(a·k − 1)`: a relieved pack that barely
-    // self-locks while slipping, or does not, is refused (Monitor::new's bound).
+    // self-locks while slipping, or does not, is refused (the bound of Monitor::new's band).
     let a_k = overrun.map_or(a * k, |l| l.gain / (l.gain - 2.0));
     if relieved && a_k < MIN_SELF_LOCKING {
         return Err(format!(

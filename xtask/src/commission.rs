@@ -52,6 +52,17 @@ pub fn main(a: &CommissionArgs) -> Result<i32, String> {
             ),
         ));
     }
+    // The record first: a bad one is refused before any acceptance run is read.
+    let mut base = Config::default();
+    if let Some(path) = &a.as_built {
+        let record = std::fs::read_to_string(path)
+            .map_err(|e| e.to_string())
+            .and_then(|text| AsBuilt::parse(&text));
+        match record {
+            Ok(r) => base.mechanism = r.applied_to(&base.mechanism),
+            Err(e) => return Ok(bad_input("commission", &format!("{}: {e}", path.display()))),
+        }
+    }
     let mut runs = Vec::new();
     // The unit's functional tests at acceptance: (trace, its scene), set after the rest.
     let mut test_runs = Vec::new();
@@ -74,16 +85,6 @@ pub fn main(a: &CommissionArgs) -> Result<i32, String> {
             ));
         };
         runs.push((trace, load));
-    }
-    let mut base = Config::default();
-    if let Some(path) = &a.as_built {
-        let record = std::fs::read_to_string(path)
-            .map_err(|e| e.to_string())
-            .and_then(|text| AsBuilt::parse(&text));
-        match record {
-            Ok(r) => base.mechanism = r.applied_to(&base.mechanism),
-            Err(e) => return Ok(bad_input("commission", &format!("{}: {e}", path.display()))),
-        }
     }
     let pairs: Vec<(&Trace, f64)> = runs.iter().map(|(t, l)| (t, *l)).collect();
     let mut c = match host_tests::commission::commission_with(&pairs, base) {

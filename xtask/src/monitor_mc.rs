@@ -96,8 +96,8 @@ struct RunArgs {
     /// docs/model.md), reported per form; the page is written for the default family only.
     #[arg(long, value_parser = family, default_value = "physical-default", value_name = "physical-default|plant")]
     family: Family,
-    /// Commission each draw's unit on the acceptance procedure of its healthy plant
-    /// (docs/commissioning.md) and run it on that configuration (uncommissioned where
+    /// Commission each draw's unit on the acceptance procedure of its healthy plant and its
+    /// build record as inspection measures it (docs/commissioning.md) and run it on that configuration (uncommissioned where
     /// acceptance refuses it, counted); the page is not written.
     #[arg(long)]
     commissioned: bool,

@@ -250,7 +250,10 @@ pub fn main(a: &FamilyArgs) -> Result<(), String> {
          is without it.\n\
          - Seed {TUNING_SEED} is where the plant family's thresholds were chosen; seed \
          {EVALUATION_SEED} was never tuned on. Commissioning's rules were not chosen on \
-         either.",
+         either, but for one: its refusal of a relieved pack whose runs give `a·k` below 1.05 \
+         was added after a draw of seed {EVALUATION_SEED} ended trusted 97 % off (its bound \
+         is `Monitor::new`'s; decisions.md, \"A unit's build record sets its pack's preload \
+         and geometry at commissioning\").",
         a.runs, a.fault_runs, a.runs, a.fault_runs
     );
     let get = |k: &str| all.get(k).cloned().unwrap_or(Value::Null);
