@@ -80,7 +80,7 @@ pub use crate::fx::mul_q16;
 pub use config::{
     AidingBraking, Config, ConfigError, DrivingPack, LockTimes, ObserverGains, OverrunLine,
     Thresholds, DEFAULT_BRAKING_MODEL_HZ, DEFAULT_OBSERVER_BANDWIDTH_HZ, DEFAULT_TICK_HZ,
-    POWER_ON_SEED_TICKS,
+    MARGINAL_SELF_LOCKING, POWER_ON_SEED_TICKS,
 };
 pub use io::{BrakeState, Estimate, Flags, Inputs, Scene, SceneModel, ESTIMATE_WORDS};
 pub use scale::{sat_i32, Scale, ScaleError};

@@ -13,7 +13,6 @@ use host_tests::as_built::AsBuilt;
 use host_tests::commission::{commission_unit, commission_unit_with, ACCEPTANCE};
 use host_tests::family::{form, runs_and_seed};
 use host_tests::mc::{braking_draws, commission_draw};
-use noback::monitor::Config;
 use noback_twin::trace::Trace;
 use std::collections::BTreeMap;
 
@@ -42,8 +41,7 @@ fn main() -> Result<(), String> {
     for draw in braking_draws(seed, runs) {
         let (i, d, trace) = draw?;
         let recorded = if exact {
-            let mut base = Config::default();
-            base.mechanism = AsBuilt::of(&d.scene.mechanism).applied_to(&base.mechanism);
+            let base = AsBuilt::of(&d.scene.mechanism).config();
             commission_unit_with(&d.scene, &ACCEPTANCE, |t| d.mount(t), base)
         } else {
             commission_draw(&d)

@@ -3,6 +3,7 @@
 //! geometry — which commissioning sets the monitor's mechanism from in place of Table 2's.
 
 use noback::mechanism::Mechanism;
+use noback::monitor::Config;
 use noback_twin::sensing::Rng;
 use toml::{Table, Value};
 
@@ -27,7 +28,7 @@ pub const CHAMFER_TOLERANCE_RAD: f64 = 0.25 * core::f64::consts::PI / 180.0;
 pub const RADIUS_TOLERANCE: f64 = 0.005;
 
 /// The monitor's mechanism fields a record sets, in the configuration file's keys.
-fn fields(m: &mut Mechanism) -> [(&'static str, &mut f64); 5] {
+pub(crate) fn fields(m: &mut Mechanism) -> [(&'static str, &mut f64); 5] {
     [
         ("spring_preload_m", &mut m.spring_preload_m),
         ("socket_radius_m", &mut m.socket_radius_m),
@@ -62,6 +63,13 @@ impl AsBuilt {
             pack_inner_radius_m: exact.pack_inner_radius_m * within(1.0, RADIUS_TOLERANCE),
             pack_outer_radius_m: exact.pack_outer_radius_m * within(1.0, RADIUS_TOLERANCE),
         }
+    }
+
+    /// The uncommissioned configuration with the record's pack: where commissioning starts.
+    pub fn config(&self) -> Config {
+        let mut c = Config::default();
+        c.mechanism = self.applied_to(&c.mechanism);
+        c
     }
 
     /// `design` with the record's quantities: the preload force through the design's spring
@@ -119,35 +127,6 @@ impl AsBuilt {
     }
 }
 
-/// The configuration file's `[monitor.mechanism]` over `design`: the keys a record sets.
-pub fn mechanism_table(design: &Mechanism, mut given: Table) -> Result<Mechanism, String> {
-    let mut m = *design;
-    for (key, field) in fields(&mut m) {
-        if let Some(v) = given.remove(key) {
-            *field = match v {
-                Value::Float(x) => x,
-                Value::Integer(i) => i as f64,
-                _ => return Err(format!("monitor.mechanism.{key}: expected a number")),
-            };
-        }
-    }
-    match given.keys().next() {
-        Some(k) => Err(format!("monitor.mechanism.{k}: unknown key")),
-        None => Ok(m),
-    }
-}
-
-/// `[monitor.mechanism]`'s lines: the keys whose value differs from `design`'s.
-pub fn mechanism_lines(design: &Mechanism, m: &Mechanism) -> String {
-    let (mut design, mut m) = (*design, *m);
-    fields(&mut design)
-        .into_iter()
-        .zip(fields(&mut m))
-        .filter(|((_, d), (_, v))| d != v)
-        .map(|((key, _), (_, v))| format!("{key} = {:?}\n", *v))
-        .collect()
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -201,30 +180,29 @@ mod tests {
         let r = AsBuilt::parse(good).expect("a whole record");
         assert_eq!(r.spring_preload_n, 180.0);
         assert_eq!(r.socket_chamfer_rad, 0.80);
-        let missing = good.replace("socket_radius_m = 0.0201\n", "");
-        assert_eq!(
-            AsBuilt::parse(&missing),
-            Err("as_built.socket_radius_m: missing".into())
-        );
-        let extra = format!("{good}mu_static = 0.3\n");
-        assert_eq!(
-            AsBuilt::parse(&extra),
-            Err("as_built.mu_static: unknown key".into())
-        );
-        let negative = good.replace("180.0", "-180.0");
-        assert_eq!(
-            AsBuilt::parse(&negative),
-            Err("as_built.spring_preload_n: expected a positive number".into())
-        );
-        let degrees = good.replace("0.80", "45.0");
-        assert_eq!(
-            AsBuilt::parse(&degrees),
-            Err("as_built.socket_chamfer_rad: expected radians below π/2".into())
-        );
-        let swapped = good.replace("0.0375", "0.0200");
-        assert_eq!(
-            AsBuilt::parse(&swapped),
-            Err("as_built.pack_inner_radius_m: expected below pack_outer_radius_m".into())
-        );
+        for (bad, error) in [
+            (
+                good.replace("socket_radius_m = 0.0201\n", ""),
+                "as_built.socket_radius_m: missing",
+            ),
+            (
+                format!("{good}mu_static = 0.3\n"),
+                "as_built.mu_static: unknown key",
+            ),
+            (
+                good.replace("180.0", "-180.0"),
+                "as_built.spring_preload_n: expected a positive number",
+            ),
+            (
+                good.replace("0.80", "45.0"),
+                "as_built.socket_chamfer_rad: expected radians below π/2",
+            ),
+            (
+                good.replace("0.0375", "0.0200"),
+                "as_built.pack_inner_radius_m: expected below pack_outer_radius_m",
+            ),
+        ] {
+            assert_eq!(AsBuilt::parse(&bad), Err(error.to_string()), "{bad}");
+        }
     }
 }

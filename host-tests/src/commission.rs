@@ -23,7 +23,9 @@ mod lock_times;
 use crate::accuracy::{run_monitor, scene_trace};
 use noback::fx::{adc_centered, counter_delta};
 use noback::mechanism::Mechanism;
-use noback::monitor::{AidingBraking, Config, DrivingPack, OverrunLine, Thresholds};
+use noback::monitor::{
+    AidingBraking, Config, DrivingPack, OverrunLine, Thresholds, MARGINAL_SELF_LOCKING,
+};
 use noback_twin::scene::{Scene, SceneKind};
 use noback_twin::trace::Trace;
 
@@ -53,9 +55,6 @@ pub const BRAKING_SHARE_MARGIN: f64 = 0.8;
 pub const MIN_LOAD_SPAN_NM: f64 = 5.0;
 /// Plausible range of the identified gain (measured drive torque over true).
 pub const GAIN_RANGE: (f64, f64) = (0.5, 2.0);
-/// The least `a·k` a relieved pack's closings can be read at: the bound of the band around 1
-/// that `Monitor::new` refuses without a measured overrunning line.
-pub const MIN_SELF_LOCKING: f64 = 1.05;
 
 /// What one acceptance run showed.
 #[derive(Clone, Debug, PartialEq)]
@@ -372,11 +371,12 @@ pub fn commission_with(runs: &[(&Trace, f64)], base: Config) -> Result<Commissio
         (false, _) => None,
     };
     // The closing estimate reads the load off `1/(a·k − 1)`: a relieved pack that barely
-    // self-locks while slipping, or does not, is refused (the bound of Monitor::new's band).
-    let a_k = overrun.map_or(a * k, |l| l.gain / (l.gain - 2.0));
-    if relieved && a_k < MIN_SELF_LOCKING {
+    // self-locks while slipping, or does not, is refused (the top of Monitor::new's band).
+    let a_k = overrun.map_or(a * k, |l| l.self_locking_ratio());
+    let least = MARGINAL_SELF_LOCKING.1;
+    if relieved && a_k < least {
         return Err(format!(
-            "the runs give a·k = {a_k:.3}: a pack that self-locks too little while slipping for its closings to be read (a·k ≥ {MIN_SELF_LOCKING})"
+            "the runs give a·k = {a_k:.3}: a pack that self-locks too little while slipping for its closings to be read (a·k ≥ {least})"
         ));
     }
     let braking_share = heaviest.braking_share;

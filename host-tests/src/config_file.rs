@@ -35,6 +35,7 @@
 //! against_s = 0.0164
 //! ```
 
+use crate::as_built::fields;
 use noback::monitor::functional_test::TestConfig;
 use noback::monitor::{
     AidingBraking, Config, DrivingPack, LockTimes, Monitor, OverrunLine, Thresholds,
@@ -179,8 +180,13 @@ pub fn parse(text: &str) -> Result<Config, String> {
         c.thresholds = thresholds(c.thresholds, table(t, "monitor.thresholds")?)?;
     }
     if let Some(t) = m.remove("mechanism") {
-        let t = table(t, "monitor.mechanism")?;
-        c.mechanism = crate::as_built::mechanism_table(&c.mechanism, t)?;
+        let mut given = table(t, "monitor.mechanism")?;
+        for (key, field) in fields(&mut c.mechanism) {
+            if let Some(v) = given.remove(key) {
+                *field = number(&v, &format!("monitor.mechanism.{key}"))?;
+            }
+        }
+        no_more(&given, "monitor.mechanism.")?;
     }
     if let Some(t) = m.remove("functional_test") {
         let path = "monitor.functional_test";
@@ -291,7 +297,14 @@ pub fn write(c: &Config, comment: &str) -> Result<String, String> {
             }
         }
     }
-    let mechanism = crate::as_built::mechanism_lines(&Config::default().mechanism, &c.mechanism);
+    // The record's fields that differ from Table 2's.
+    let (mut design, mut built) = (Config::default().mechanism, c.mechanism);
+    let mechanism: String = fields(&mut design)
+        .into_iter()
+        .zip(fields(&mut built))
+        .filter(|((_, d), (_, v))| d != v)
+        .map(|((key, _), (_, v))| format!("{key} = {:?}\n", *v))
+        .collect();
     if !mechanism.is_empty() {
         out.push_str("[monitor.mechanism]\n");
         out.push_str(&mechanism);

@@ -4,7 +4,6 @@
 use host_tests::accuracy::{compare, run_monitor, scene_trace};
 use host_tests::as_built::AsBuilt;
 use host_tests::commission::{commission_unit, commission_unit_with, ACCEPTANCE};
-use noback::monitor::Config;
 use noback_twin::reading::Reading;
 use noback_twin::scene::{Scene, SceneKind};
 
@@ -26,8 +25,7 @@ fn off_design() -> Scene {
 fn the_build_record_puts_the_pressing_force_within_ten_percent() {
     let unit = off_design();
     let design = commission_unit(&unit, &ACCEPTANCE, |_| {}).unwrap().config;
-    let mut base = Config::default();
-    base.mechanism = AsBuilt::inspected(&unit.mechanism, 1).applied_to(&base.mechanism);
+    let base = AsBuilt::inspected(&unit.mechanism, 1).config();
     let built = commission_unit_with(&unit, &ACCEPTANCE, |_| {}, base)
         .unwrap()
         .config;

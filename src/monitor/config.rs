@@ -275,6 +275,10 @@ pub struct AidingBraking {
     pub load_gain: f64,
 }
 
+/// The sliding self-locking ratio `a·k` a configuration without a measured overrunning line is
+/// refused within (exclusive): the model's line divides by `a·k − 1`.
+pub const MARGINAL_SELF_LOCKING: (f64, f64) = (0.95, 1.05);
+
 /// A relieved pack's overrunning equilibrium `y = g₁·v − g₀` measured at commissioning from
 /// closings at two loads (docs/commissioning.md); it stands for the one `sliding_mu` gives.
 #[cfg_attr(feature = "config-block", derive(serde::Serialize, serde::Deserialize))]
@@ -284,6 +288,13 @@ pub struct OverrunLine {
     pub gain: f64,
     /// `g₀` (N·m, > 0).
     pub offset_nm: f64,
+}
+
+impl OverrunLine {
+    /// The `a·k` its gain implies: `g₁ = 2a·k/(a·k − 1)`.
+    pub fn self_locking_ratio(&self) -> f64 {
+        self.gain / (self.gain - 2.0)
+    }
 }
 
 /// A relieved pack's time from the drive's cut to the monitor's first lock, measured at

@@ -9,7 +9,7 @@
 //! | `drive_force`, `drive_drag` | `F_s/(1 + a·k)` (`F_s` with `DrivingPack::SpringOnly`) and `a·F` (or the commissioned `driving_drag_nm`) while the drive carries the load | 70 N, 1.98 N·m |
 //! | `overrun_gain`, `overrun_offset` | `y = g₁·v − g₀`, the pack torque while overrunning (or the commissioned `overrun_line`) | 6.86, 11.6 N·m |
 
-use super::config::{Config, ConfigError, DrivingPack};
+use super::config::{Config, ConfigError, DrivingPack, MARGINAL_SELF_LOCKING};
 use super::convert::{finite, positive, q16, require, scale, Q16_ENVELOPE};
 use super::scale::Scale;
 use crate::fx::Q16;
@@ -125,11 +125,11 @@ impl PackSettings {
                 (
                     (gain, "overrun_line.gain"),
                     (offset, "overrun_line.offset_nm"),
-                    gain / (gain - 2.0),
+                    l.self_locking_ratio(),
                 )
             }
             // The model's line divides by a·k − 1: refused near 1 (a measured line is not).
-            None if a_k > 0.95 && a_k < 1.05 => {
+            None if a_k > MARGINAL_SELF_LOCKING.0 && a_k < MARGINAL_SELF_LOCKING.1 => {
                 return Err(ConfigError::OutOfRange {
                     parameter: "sliding_mu",
                 })

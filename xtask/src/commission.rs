@@ -53,16 +53,16 @@ pub fn main(a: &CommissionArgs) -> Result<i32, String> {
         ));
     }
     // The record first: a bad one is refused before any acceptance run is read.
-    let mut base = Config::default();
-    if let Some(path) = &a.as_built {
-        let record = std::fs::read_to_string(path)
+    let base = match &a.as_built {
+        None => Config::default(),
+        Some(path) => match std::fs::read_to_string(path)
             .map_err(|e| e.to_string())
-            .and_then(|text| AsBuilt::parse(&text));
-        match record {
-            Ok(r) => base.mechanism = r.applied_to(&base.mechanism),
+            .and_then(|text| AsBuilt::parse(&text))
+        {
+            Ok(r) => r.config(),
             Err(e) => return Ok(bad_input("commission", &format!("{}: {e}", path.display()))),
-        }
-    }
+        },
+    };
     let mut runs = Vec::new();
     // The unit's functional tests at acceptance: (trace, its scene), set after the rest.
     let mut test_runs = Vec::new();

@@ -19,9 +19,8 @@ pub fn block_is_bit_exact(core: Core) -> Result<(), String> {
     )?;
     let trace = crate::replay::twin_trace(&scene)?;
     // With a build record (as inspection measures a Table 2 unit): the block carries its model.
-    let mut base = Config::default();
-    let record = host_tests::as_built::AsBuilt::inspected(&base.mechanism, 1);
-    base.mechanism = record.applied_to(&base.mechanism);
+    let table2 = Config::default().mechanism;
+    let base = host_tests::as_built::AsBuilt::inspected(&table2, 1).config();
     let c = host_tests::commission::commission_with(&[(&trace, 20.3)], base)?;
     let (report, ok) = run::replay_report_with(&scene, core, None, None, false, Some(c.config))?;
     let uncommissioned =

@@ -348,7 +348,8 @@ fn trip_log_holds() -> Result<(), String> {
     use noback::monitor::Config;
     let code = crate::trip_log::power_fail(&crate::trip_log::PowerFailArgs { json: false })?;
     let mut all = code == 0;
-    for config in [Config::default(), Config::physical_reading()] {
+    let (default, physical) = (Config::default(), Config::physical_reading());
+    for (config, other) in [(default, physical), (physical, default)] {
         let (records, _) = crate::trip_log::record_scene(&fault_scene()?, config)?;
         all &= !records.is_empty();
         for bytes in &records {
@@ -356,11 +357,6 @@ fn trip_log_holds() -> Result<(), String> {
             println!("{line}");
             all &= same;
         }
-        let other = if config == Config::default() {
-            Config::physical_reading()
-        } else {
-            Config::default()
-        };
         all &= records
             .iter()
             .all(|b| crate::trip_log::replay(b, other).is_err());

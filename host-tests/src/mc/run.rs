@@ -183,10 +183,8 @@ pub fn evaluate(d: &Draw, campaign: &Campaign) -> Outcome {
 /// of its healthy plant, its sensors mounted as the draw's, from its build record as inspection
 /// measured it ([`crate::as_built::AsBuilt::inspected`], drawn apart from the run's draws).
 pub fn commission_draw(d: &Draw) -> Result<crate::commission::Commissioning, String> {
-    let record =
-        crate::as_built::AsBuilt::inspected(&d.scene.mechanism, d.scene.noise.seed ^ RECORD_STREAM);
-    let mut base = Config::default();
-    base.mechanism = record.applied_to(&base.mechanism);
+    let seed = d.scene.noise.seed ^ RECORD_STREAM;
+    let base = crate::as_built::AsBuilt::inspected(&d.scene.mechanism, seed).config();
     let plan = &crate::commission::ACCEPTANCE;
     crate::commission::commission_unit_with(&d.scene, plan, |t| d.mount(t), base)
 }
