@@ -317,6 +317,9 @@ impl Monitor {
             }
         } else if let Some(cut) = cut.as_mut() {
             cut.travel(x);
+            if let Some(a) = k.aiding.as_ref().filter(|_| WINDOW.slot(st.tick) == 0) {
+                cut.read_so_far(a);
+            }
         }
         // Check: the braking envelope and creep, on this tick's motion.
         let dir = Dir::of(o.w, k.scene.stick_speed);
@@ -347,7 +350,7 @@ impl Monitor {
         match slot {
             _ if x.first => {
                 reading_switch = st.classify(k, x, o);
-                st.estimate(k);
+                st.estimate(k, None);
             }
             Slot::Classify => {
                 reading_switch = st.classify(k, x, o);
@@ -357,7 +360,7 @@ impl Monitor {
                     k.refresh_load(&mut st.load);
                 }
             }
-            Slot::Estimate => st.estimate(k),
+            Slot::Estimate => st.estimate(k, cut.as_ref().and_then(Cut::so_far)),
             Slot::Sync if x.drive => st.classify.sync_window(&k.scene, x, o.w),
             _ => {}
         }
@@ -455,7 +458,8 @@ impl State {
 
     /// The slow lane's [`Slot::Estimate`]: the pack's force and torque at the last
     /// classification (its snapshot of the observer), the input speed, the friction energy.
-    fn estimate(&mut self, k: &Settings) {
+    /// `braking_load`: an aiding load's reading from the braking so far (`aiding`).
+    fn estimate(&mut self, k: &Settings, braking_load: Option<Q16>) {
         let (c, o) = (&self.classified, &self.observed);
         self.sense.sample_input_speed(&k.sense);
         let load = self.load.estimate.value();
@@ -476,6 +480,7 @@ impl State {
                 measured,
                 engaged_capacity: self.load.cache.capacity,
                 drive_torque: o.drive_torque,
+                braking_load: braking_load.filter(|_| self.load.unseen()),
             },
         );
         self.energy

@@ -8,7 +8,8 @@
 //! | step | when | does |
 //! |---|---|---|
 //! | [`Cut::at`] | the drive is cut (a unit with `AidingBraking`) | keeps the observer's speed |
-//! | [`Cut::travel`] | every tick after | sums the output's travel (a braking may pass half a turn) |
+//! | [`Cut::travel`] | every tick after | sums the output's travel (a braking may pass half a turn) and the ticks |
+//! | [`Cut::read_so_far`] | once per window after it | `M̂` so far, `α = 2(ω₀·t − θ)/t²`: the pressing force's load until the lock |
 //! | [`Cut::load_at_lock`] | the first lock after it, the load unseen | `M̂` along the motion, known if `M̂ ≥ D` and `g·M̂ ≥` [`CONDITIONING`]`·D` |
 //!
 //! Below `D` the ramps need not clamp (the seated pack brakes a lighter load alone), and the
@@ -20,6 +21,9 @@
 //! | `ω₀²` | [`Q16`] rad²/s², saturating | 0 … 32 768 | 1.5e-5 |
 //! | `ω₀²/θ` | `i32` Q24 rad²/s² per count, saturating | 0 … 128 | 6e-8 |
 //! | braking angle | `i32` counts, saturating sum of the ticks' travel | ±2^31 counts | 1 count |
+//! | ticks since the cut | `u32`, saturating | 5 days at 10 kHz | 1 tick |
+//! | `ω₀·t − θ` | `i64` Q16 counts (`ω₀·h` in Q16 counts per tick, saturating) | ±2^47 counts | 1.5e-5 count |
+//! | `α·h²` | `i32` Q32 counts per tick², saturating | ±0.5 (±19 000 rad/s² at 10 kHz) | 2.3e-10 |
 //! | `J·α`, `M̂` | [`Q16`] N·m, saturating | ±32 768 | 1.5e-5 N·m |
 
 use super::config::{Config, ConfigError};
@@ -33,6 +37,10 @@ use crate::fx::Q16;
 /// The least `g·M̂/D` at which the reading is taken: `J·α`'s error (≤ 0.6 % on tuning seed
 /// 1616's forward loads) times `1 + D/(g·M̂)` stays within 2 %.
 pub const CONDITIONING: f64 = 0.4;
+
+/// The least lag behind the cut's speed (`ω₀·t − θ`, counts) the braking so far is read from:
+/// the encoder's count is then at most a quarter of it.
+const SO_FAR_MIN_COUNTS: i64 = 4;
 
 /// The reading's constants (present once commissioning identified them).
 #[cfg_attr(
@@ -49,6 +57,10 @@ pub(crate) struct AidingSettings {
     per_gain: Scale<24>,
     /// `(1 + CONDITIONING)·D`: the least `J·α` of a trusted reading.
     trust_floor: Q16,
+    /// `h/(rad per count)`: `ω₀` (Q16 rad/s) → Q16 counts per tick.
+    counts_per_tick: Scale<29>,
+    /// `2J·(rad per count)·tick_hz²·2^-16`: `α·h²` (Q32 counts per tick²) → `J·α` (Q16 N·m).
+    so_far_torque_per: Scale<29>,
 }
 
 impl AidingSettings {
@@ -68,6 +80,14 @@ impl AidingSettings {
             drag: q16(drag, "aiding_braking.drag_nm")?,
             per_gain: scale(1.0 / gain, "aiding_braking.load_gain")?,
             trust_floor: q16((1.0 + CONDITIONING) * drag, "aiding_braking.drag_nm")?,
+            counts_per_tick: scale(
+                1.0 / (c.tick_hz * c.sensors.output_rad_per_count()),
+                "tick_hz",
+            )?,
+            so_far_torque_per: scale(
+                2.0 * inertia * c.sensors.output_rad_per_count() * c.tick_hz * c.tick_hz / 65_536.0,
+                "aiding_braking.inertia_kg_m2",
+            )?,
         }))
     }
 }
@@ -82,18 +102,63 @@ pub(crate) struct Cut {
     w: Q16,
     /// Output counts since the cut.
     travel: i32,
+    /// Ticks since the cut.
+    ticks: u32,
+    /// The load the braking so far implies (magnitude, `≥ 0`), once read.
+    so_far: Option<Q16>,
 }
 
 impl Cut {
     /// At the cut: the observer's speed.
     pub fn at(o: &Observed) -> Cut {
-        Cut { w: o.w, travel: 0 }
+        Cut {
+            w: o.w,
+            travel: 0,
+            ticks: 0,
+            so_far: None,
+        }
     }
 
-    /// Each tick after the cut: the output's travel.
+    /// Each tick after the cut: the output's travel and the ticks it took.
     #[inline]
     pub fn travel(&mut self, x: &Sensed) {
         self.travel = self.travel.saturating_add(x.d_out);
+        self.ticks = self.ticks.saturating_add(x.n);
+    }
+
+    /// Once per window: the load (magnitude) that braked the output so far at a constant
+    /// deceleration, `J·α = D + g·M̂`, `α = 2(ω₀·t − θ)/t²`, once the output lags the cut's
+    /// speed by [`SO_FAR_MIN_COUNTS`]; floored at 0.
+    pub fn read_so_far(&mut self, k: &AidingSettings) {
+        let speed = i64::from(k.counts_per_tick.apply(self.w.saturating_abs().to_bits()));
+        let along = i64::from(if self.w < Q16::ZERO {
+            self.travel.saturating_neg()
+        } else {
+            self.travel
+        });
+        let ticks = i64::from(self.ticks);
+        let lag = speed
+            .saturating_mul(ticks)
+            .saturating_sub(along.saturating_mul(1 << 16));
+        if lag < SO_FAR_MIN_COUNTS << 16 {
+            return;
+        }
+        let Some(decel) = lag
+            .saturating_mul(1 << 16)
+            .checked_div(ticks.saturating_mul(ticks))
+        else {
+            return;
+        };
+        let decel_torque = Q16::from_bits(k.so_far_torque_per.apply(sat_i32(decel)));
+        let load = k
+            .per_gain
+            .apply(decel_torque.saturating_sub(k.drag).to_bits());
+        self.so_far = Some(Q16::from_bits(load.max(0)));
+    }
+
+    /// The load the braking so far implies, once read.
+    pub fn so_far(&self) -> Option<Q16> {
+        self.so_far
     }
 
     /// The load along the motion (signed as the speed at the cut) that braked the output from
@@ -197,6 +262,41 @@ mod tests {
             .expect("identified");
         let m = lock_after(&slow, &ks, 20.0, 400.0 / (2.0 * 23.0 / 0.5)).expect("clamped");
         assert!((m - 10.0).abs() < 0.05, "{m}");
+    }
+
+    /// The load read so far while braking at `J·α = D + g·M` from `w`, after `ms`.
+    fn so_far_after(k: &AidingSettings, c: &Config, w: f64, load: f64, ms: u32) -> Option<f64> {
+        let alpha = (8.0 + 1.5 * load) / 0.05 * w.signum();
+        let mut cut = Cut::at(&Observed {
+            w: Q16::from_num(w),
+            ..Observed::NONE
+        });
+        let (h, per) = (1.0 / c.tick_hz, c.sensors.output_rad_per_count());
+        let count = |t: f64| ((w * t - alpha * t * t / 2.0) / per).floor() as i32;
+        for i in 1..=ms * 10 {
+            let t = f64::from(i) * h;
+            cut.travel(&Sensed {
+                d_out: count(t) - count(t - h),
+                n: 1,
+                ..Sensed::NONE
+            });
+        }
+        cut.read_so_far(k);
+        cut.so_far().map(|m| m.to_num::<f64>())
+    }
+
+    #[test]
+    fn the_braking_so_far_gives_the_load_before_the_lock() {
+        let (c, k) = unit();
+        // 20 N·m from 10 rad/s: α = 760 rad/s²; 4 ms in, the output lags the cut's speed by
+        // 6.1e-3 rad (16 counts), the count within 1 of it.
+        for (w, ms, within) in [(10.0, 4, 1.5), (10.0, 10, 0.3), (-10.0, 10, 0.3)] {
+            let m = so_far_after(&k, &c, w, 20.0, ms).expect("read");
+            assert!((m - 20.0).abs() < within, "{w} rad/s, {ms} ms: {m}");
+        }
+        // Too early to read (a lag under 4 counts), and a load below the drag floors at 0.
+        assert_eq!(so_far_after(&k, &c, 10.0, 20.0, 1), None);
+        assert_eq!(so_far_after(&k, &c, 10.0, -4.0, 20), Some(0.0));
     }
 
     #[test]

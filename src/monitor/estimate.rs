@@ -7,7 +7,7 @@
 //! | `Driving` | `F_drive = F_s/(1 + a·k)` | Table 1 at the drive drag `a·F_drive` |
 //! | `Overrunning` | `F_s + k·(T_o − v)`, `T_o = y − v` | `y = g₁·v − g₀` against the motion |
 //! | `Holding` | `F_s + k·|T|` (`F_s`: a spring-only pack's ramps open) | `T = M̂ − J_s·α` (α from the impacts of the rattle) |
-//! | `FaultBraking` | `F_s + k·|T|`; a spring-only pack: `F_s`, ramps open (against the load, turning back: `stop.rs`), else `F_s + k·|M̂|` | `T` measured: `M̂ − (J_s·ω̇ − u)` |
+//! | `FaultBraking` | `F_s + k·|T|`; a spring-only pack: `F_s`, ramps open (against the load, turning back: `stop.rs`), else `F_s + k·|M̂|` (`M̂` unseen: the braking's so far, `aiding.rs`) | `T` measured: `M̂ − (J_s·ω̇ − u)` |
 //!
 //! Engaged, the torque is bounded by the capacity at that force (it binds only when the force
 //! saturates or the pack does not self-lock).
@@ -100,6 +100,8 @@ pub(crate) struct PackInputs {
     /// Capacity of the engaged pack at the load.
     pub engaged_capacity: Q16,
     pub drive_torque: Q16,
+    /// An unseen aiding load read from the braking since the cut (`aiding`), if any.
+    pub braking_load: Option<Q16>,
 }
 
 /// Force and torques for one call.
@@ -141,7 +143,7 @@ pub(crate) fn pack(k: &PackSettings, c: &Classified, i: &PackInputs) -> PackEsti
             let force = match (k.spring_only, c.scene) {
                 _ if c.ramps_open => k.spring_force,
                 (true, Scene::FaultBraking) if !c.load_along => k.spring_force,
-                (true, Scene::FaultBraking) => k.clamped_force(i.load),
+                (true, Scene::FaultBraking) => k.clamped_force(i.braking_load.unwrap_or(i.load)),
                 _ => k.clamped_force(t),
             };
             (force, t)
