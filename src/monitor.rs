@@ -133,6 +133,8 @@ struct State {
     reading_switch: bool,
     /// The commanded functional test, from the crew's request.
     test: Option<FunctionalTest>,
+    /// Where the drive was last cut, until the lock after it (`aiding`).
+    cut: Option<Cut>,
 }
 
 /// The monitor: settings apart from state. One [`Monitor::step`] per tick.
@@ -148,8 +150,6 @@ pub struct Monitor {
     job: Job,
     /// `job` waits for [`Monitor::background`].
     job_due: bool,
-    /// Where the drive was last cut, until the lock after it (`aiding`).
-    cut: Option<Cut>,
 }
 
 impl Monitor {
@@ -194,13 +194,13 @@ impl Monitor {
                 gave_way: false,
                 reading_switch: false,
                 test: None,
+                cut: None,
             },
             job: Job {
                 x: Sensed::NONE,
                 o: Observed::NONE,
             },
             job_due: false,
-            cut: None,
         }
     }
 
@@ -304,18 +304,18 @@ impl Monitor {
         if !core::mem::take(&mut self.job_due) {
             return;
         }
-        let (k, st, cut) = (&self.settings, &mut self.state, &mut self.cut);
+        let (k, st) = (&self.settings, &mut self.state);
         let Job { ref x, ref o } = self.job;
         let slot = Slot::of(st.tick);
         // The tick's events: a drive edge, an implausible step.
         st.classify.tick(x, o);
         st.checks.events(&k.checks, x, o);
         if x.drive_edge {
-            *cut = (!x.drive && k.aiding.is_some()).then(|| Cut::at(o));
+            st.cut = (!x.drive && k.aiding.is_some()).then(|| Cut::at(o));
             if x.drive {
                 st.load.drive_started();
             }
-        } else if let Some(cut) = cut.as_mut() {
+        } else if let Some(cut) = st.cut.as_mut() {
             cut.travel(x);
             if let Some(a) = k.aiding.as_ref().filter(|_| WINDOW.slot(st.tick) == 0) {
                 cut.read_so_far(a);
@@ -350,17 +350,17 @@ impl Monitor {
         match slot {
             _ if x.first => {
                 reading_switch = st.classify(k, x, o);
-                st.estimate(k, None);
+                st.estimate(k);
             }
             Slot::Classify => {
                 reading_switch = st.classify(k, x, o);
                 // An aiding load a spring-only pack hid while driving, read at the lock.
-                let locked = st.classified.just_locked.then(|| cut.take()).flatten();
+                let locked = st.classified.just_locked.then(|| st.cut.take()).flatten();
                 if aiding::read_at_lock(locked, k.aiding.as_ref(), &mut st.load) {
                     k.refresh_load(&mut st.load);
                 }
             }
-            Slot::Estimate => st.estimate(k, cut.as_ref().and_then(Cut::so_far)),
+            Slot::Estimate => st.estimate(k),
             Slot::Sync if x.drive => st.classify.sync_window(&k.scene, x, o.w),
             _ => {}
         }
@@ -458,8 +458,7 @@ impl State {
 
     /// The slow lane's [`Slot::Estimate`]: the pack's force and torque at the last
     /// classification (its snapshot of the observer), the input speed, the friction energy.
-    /// `braking_load`: an aiding load's reading from the braking so far (`aiding`).
-    fn estimate(&mut self, k: &Settings, braking_load: Option<Q16>) {
+    fn estimate(&mut self, k: &Settings) {
         let (c, o) = (&self.classified, &self.observed);
         self.sense.sample_input_speed(&k.sense);
         let load = self.load.estimate.value();
@@ -480,7 +479,11 @@ impl State {
                 measured,
                 engaged_capacity: self.load.cache.capacity,
                 drive_torque: o.drive_torque,
-                braking_load: braking_load.filter(|_| self.load.unseen()),
+                braking_load: self
+                    .cut
+                    .as_ref()
+                    .and_then(Cut::so_far)
+                    .filter(|_| self.load.unseen()),
             },
         );
         self.energy

@@ -27,7 +27,10 @@ const LOCK_S: f64 = 0.010;
 fn output_rest(trace: &Trace, cut: f64, band: f64) -> Option<f64> {
     let w0 = trace.rows.iter().find(|r| r.t_s >= cut)?.output_speed_rad_s;
     let rest = |w: f64| w * w0 <= 0.0 || w.abs() < band;
-    let row = trace.rows.iter().find(|r| r.t_s >= cut && rest(r.output_speed_rad_s));
+    let row = trace
+        .rows
+        .iter()
+        .find(|r| r.t_s >= cut && rest(r.output_speed_rad_s));
     row.map(|r| r.t_s)
 }
 
@@ -52,9 +55,8 @@ fn main() -> Result<(), String> {
         let n = acc.monitor_force_n.len().min(est.len());
         let trusted: Vec<usize> = (0..n).filter(|&i| est[i].trusted).collect();
         let sq = |i: &usize| (acc.monitor_force_n[*i] - acc.twin_force_n[*i]).powi(2);
-        let trusted_rms = (trusted.iter().map(sq).sum::<f64>() / trusted.len().max(1) as f64)
-            .sqrt()
-            / peak;
+        let trusted_rms =
+            (trusted.iter().map(sq).sum::<f64>() / trusted.len().max(1) as f64).sqrt() / peak;
         let cut = trace
             .rows
             .windows(2)

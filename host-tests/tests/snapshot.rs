@@ -2,7 +2,7 @@
 //! tick of a scene: what lets a trip record be replayed bit-exact on the host.
 
 use host_tests::accuracy::scene_trace;
-use noback::monitor::{Config, Inputs, Monitor, SnapshotError};
+use noback::monitor::{AidingBraking, Config, DrivingPack, Inputs, Monitor, SnapshotError};
 use noback::trip_log::record::MAGIC;
 use noback_twin::scene::Scene;
 
@@ -36,6 +36,48 @@ fn a_restored_monitor_steps_on_bit_exact() {
     assert!(largest < 2048, "{largest} bytes");
 }
 
+/// A spring-only unit commissioned with its aiding braking (the paper form's acceptance values),
+/// saved while it brakes a closing's load between the cut and the lock: the braking read so far
+/// is state, restored with the rest.
+#[test]
+fn a_spring_only_unit_restored_mid_braking_steps_on_bit_exact() {
+    let c = Config {
+        driving_pack: DrivingPack::SpringOnly,
+        commissioned: true,
+        aiding_braking: Some(AidingBraking {
+            inertia_kg_m2: 0.149,
+            drag_nm: 8.37,
+            load_gain: 1.49,
+        }),
+        ..Config::default()
+    };
+    let text = "[scene]\nkind = \"forward_load\"\nreading = \"paper\"\n";
+    let trace = scene_trace(&Scene::from_toml("snap", text).unwrap()).unwrap();
+    let cut = trace
+        .rows
+        .windows(2)
+        .position(|w| w[0].drive_on && !w[1].drive_on)
+        .expect("a cut")
+        + 1;
+    for at in [cut + 40, cut + 160] {
+        let mut a = Monitor::new(c).unwrap();
+        for r in &trace.rows[..at] {
+            a.step(&inputs(r));
+        }
+        let mut buf = [0_u8; 4096];
+        let bytes = a.save_state(&mut buf).unwrap().to_vec();
+        let mut b = Monitor::restore(c, &bytes).unwrap();
+        for r in &trace.rows[at..] {
+            assert_eq!(
+                a.step(&inputs(r)).to_words(),
+                b.step(&inputs(r)).to_words(),
+                "saved {} ticks after the cut",
+                at - cut
+            );
+        }
+    }
+}
+
 #[test]
 fn a_short_buffer_or_corrupt_bytes_are_refused() {
     let m = Monitor::new(Config::default()).unwrap();
@@ -64,7 +106,7 @@ fn the_fresh_state_is_the_one_recorded_with_the_record_magic() {
     bytes.iter().for_each(|b| d.push_byte(*b));
     assert_eq!(
         (MAGIC, bytes.len(), d.value()),
-        (*b"NBT6", 274, 0x64AE_005E),
+        (*b"NBT7", 275, 0xED30_1FC0),
         "the record's magic, the fresh state's length and digest"
     );
 }

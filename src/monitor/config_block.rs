@@ -4,7 +4,7 @@
 //!
 //! | bytes | what |
 //! |---|---|
-//! | 4 | magic `NBCE` (a later layout of the settings changes it) |
+//! | 4 | magic `NBCG` (a later layout of the settings changes it) |
 //! | n | the monitor's settings (`Settings::new` of the `Config`), postcard |
 //! | 4 | CRC-32/ISCSI of the settings' bytes, little-endian (postcard's `use-crc` flavour) |
 //!
@@ -16,7 +16,7 @@ use super::{Config, ConfigError, Monitor};
 use crc::{Crc, CRC_32_ISCSI};
 
 /// The block's first bytes.
-pub const CONFIG_BLOCK_MAGIC: [u8; 4] = *b"NBCE";
+pub const CONFIG_BLOCK_MAGIC: [u8; 4] = *b"NBCG";
 /// Room the firmware keeps for a block (the default settings' block takes 320 bytes).
 pub const CONFIG_BLOCK_BYTES: usize = 1024;
 

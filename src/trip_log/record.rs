@@ -3,7 +3,7 @@
 //!
 //! | bytes | field |
 //! |---|---|
-//! | 4 | magic `NBT6` |
+//! | 4 | magic `NBT7` |
 //! | 4 | tick of the flag change (the monitor's tick count) |
 //! | 1 + 1 | flags before, flags now ([`Flags::bits`]) |
 //! | 2 | state bytes `S` |
@@ -18,7 +18,7 @@ use crate::digest::Fnv1a;
 use crate::monitor::{Estimate, Flags, Inputs, Monitor, ESTIMATE_WORDS};
 
 /// The record's magic.
-pub const MAGIC: [u8; 4] = *b"NBT6";
+pub const MAGIC: [u8; 4] = *b"NBT7";
 /// Bytes per input of the window.
 pub const INPUT_BYTES: usize = 12;
 /// Bytes before the state.
