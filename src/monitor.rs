@@ -134,7 +134,7 @@ struct State {
     /// The commanded functional test, from the crew's request.
     test: Option<FunctionalTest>,
     /// Where the drive was last cut, until the lock after it (`aiding`).
-    cut: Option<Cut>,
+    cut: Cut,
 }
 
 /// The monitor: settings apart from state. One [`Monitor::step`] per tick.
@@ -194,7 +194,7 @@ impl Monitor {
                 gave_way: false,
                 reading_switch: false,
                 test: None,
-                cut: None,
+                cut: Cut::NONE,
             },
             job: Job {
                 x: Sensed::NONE,
@@ -311,11 +311,16 @@ impl Monitor {
         st.classify.tick(x, o);
         st.checks.events(&k.checks, x, o);
         if x.drive_edge {
-            st.cut = (!x.drive && k.aiding.is_some()).then(|| Cut::at(o));
+            st.cut = if !x.drive && k.aiding.is_some() {
+                Cut::at(o)
+            } else {
+                Cut::NONE
+            };
             if x.drive {
                 st.load.drive_started();
             }
-        } else if let Some(cut) = st.cut.as_mut() {
+        } else if st.cut.armed() {
+            let cut = &mut st.cut;
             cut.travel(x);
             if let Some(a) = k.aiding.as_ref().filter(|_| WINDOW.slot(st.tick) == 0) {
                 cut.read_so_far(a);
@@ -479,11 +484,7 @@ impl State {
                 measured,
                 engaged_capacity: self.load.cache.capacity,
                 drive_torque: o.drive_torque,
-                braking_load: self
-                    .cut
-                    .as_ref()
-                    .and_then(Cut::so_far)
-                    .filter(|_| self.load.unseen()),
+                braking_load: self.cut.so_far().filter(|_| self.load.unseen()),
             },
         );
         self.energy

@@ -106,7 +106,7 @@ fn the_fresh_state_is_the_one_recorded_with_the_record_magic() {
     bytes.iter().for_each(|b| d.push_byte(*b));
     assert_eq!(
         (MAGIC, bytes.len(), d.value()),
-        (*b"NBT7", 275, 0xED30_1FC0),
+        (*b"NBT7", 279, 0x2869_0853),
         "the record's magic, the fresh state's length and digest"
     );
 }

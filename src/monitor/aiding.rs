@@ -34,9 +34,10 @@ use super::sense::Sensed;
 use super::{mul_q16, observe::Observed};
 use crate::fx::Q16;
 
-/// The least `g·M̂/D` at which the reading is taken: `J·α`'s error (≤ 0.6 % on tuning seed
-/// 1616's forward loads) times `1 + D/(g·M̂)` stays within 2 %.
-pub const CONDITIONING: f64 = 0.4;
+/// The least `g·M̂/D` at which the reading is trusted, as a ratio (0.4): `J·α`'s error (≤ 0.6 %
+/// on tuning seed 1616's forward loads) times `1 + D/(g·M̂)` stays within 2 %. Compared exactly,
+/// `5·J·α ≥ (5 + 2)·D` in `i64`, no setting held for it (the part's RAM budget).
+pub const CONDITIONING: (i64, i64) = (2, 5);
 
 /// The least lag behind the cut's speed (`ω₀·t − θ`, counts) the braking so far is read from:
 /// the encoder's count is then at most a quarter of it.
@@ -55,8 +56,6 @@ pub(crate) struct AidingSettings {
     drag: Q16,
     /// `1/g`.
     per_gain: Scale<24>,
-    /// `(1 + CONDITIONING)·D`: the least `J·α` of a trusted reading.
-    trust_floor: Q16,
     /// `h/(rad per count)`: `ω₀` (Q16 rad/s) → Q16 counts per tick.
     counts_per_tick: Scale<29>,
     /// `2J·(rad per count)·tick_hz²·2^-16`: `α·h²/2` (Q32 counts per tick²) → `J·α` (Q16 N·m).
@@ -79,7 +78,6 @@ impl AidingSettings {
             )?,
             drag: q16(drag, "aiding_braking.drag_nm")?,
             per_gain: scale(1.0 / gain, "aiding_braking.load_gain")?,
-            trust_floor: q16((1.0 + CONDITIONING) * drag, "aiding_braking.drag_nm")?,
             counts_per_tick: scale(
                 1.0 / (c.tick_hz * c.sensors.output_rad_per_count()),
                 "tick_hz",
@@ -102,28 +100,53 @@ pub(crate) struct Cut {
     w: Q16,
     /// Output counts since the cut.
     travel: i32,
-    /// Ticks since the cut.
-    ticks: u32,
-    /// The load the braking so far implies (magnitude, `≥ 0`), once read.
-    so_far: Option<Q16>,
+    /// The load the braking so far implies (magnitude); [`NOT_READ`] before it is read.
+    so_far: Q16,
+    /// Ticks since the cut (saturating: 6.5 s at 10 kHz, past any braking).
+    ticks: u16,
+    /// A cut awaits its first lock (packed, no `Option`: the part's RAM budget).
+    armed: bool,
 }
 
+/// [`Cut::so_far`] not yet read (a reading is floored at 0).
+const NOT_READ: Q16 = Q16::from_bits(-1);
+
 impl Cut {
+    /// No cut awaiting a lock.
+    pub const NONE: Cut = Cut {
+        w: Q16::ZERO,
+        travel: 0,
+        so_far: NOT_READ,
+        ticks: 0,
+        armed: false,
+    };
+
     /// At the cut: the observer's speed.
     pub fn at(o: &Observed) -> Cut {
         Cut {
             w: o.w,
-            travel: 0,
-            ticks: 0,
-            so_far: None,
+            armed: true,
+            ..Cut::NONE
         }
+    }
+
+    /// A cut awaits its first lock.
+    pub fn armed(&self) -> bool {
+        self.armed
+    }
+
+    /// At the lock: the cut it ends, if one was armed.
+    pub fn take(&mut self) -> Option<Cut> {
+        let c = core::mem::replace(self, Cut::NONE);
+        c.armed.then_some(c)
     }
 
     /// Each tick after the cut: the output's travel and the ticks it took.
     #[inline]
     pub fn travel(&mut self, x: &Sensed) {
         self.travel = self.travel.saturating_add(x.d_out);
-        self.ticks = self.ticks.saturating_add(x.n);
+        let n = u16::try_from(x.n).unwrap_or(u16::MAX);
+        self.ticks = self.ticks.saturating_add(n);
     }
 
     /// Once per window: the load (magnitude) that braked the output so far at a constant
@@ -153,12 +176,12 @@ impl Cut {
         let load = k
             .per_gain
             .apply(decel_torque.saturating_sub(k.drag).to_bits());
-        self.so_far = Some(Q16::from_bits(load.max(0)));
+        self.so_far = Q16::from_bits(load.max(0));
     }
 
     /// The load the braking so far implies, once read.
     pub fn so_far(&self) -> Option<Q16> {
-        self.so_far
+        (self.armed && self.so_far >= Q16::ZERO).then_some(self.so_far)
     }
 
     /// The load along the motion (signed as the speed at the cut) that braked the output from
@@ -182,7 +205,10 @@ impl Cut {
                 .apply(decel_torque.saturating_sub(k.drag).to_bits()),
         );
         let along = if back { load.saturating_neg() } else { load };
-        (load >= k.drag).then_some((along, decel_torque >= k.trust_floor))
+        let (num, den) = CONDITIONING;
+        let trusted =
+            i64::from(decel_torque.to_bits()) * den >= i64::from(k.drag.to_bits()) * (den + num);
+        (load >= k.drag).then_some((along, trusted))
     }
 }
 
